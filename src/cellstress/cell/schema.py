@@ -1,0 +1,223 @@
+"""The cell file schema: typed, frozen records validated by pydantic.
+
+Lengths are metres, angles degrees, times seconds. The frame is right-handed with z up; the built-in cells
+put the robot base near the origin, the upper (front) end of the cell at +y and the lower (back) end at -y.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+Point2 = tuple[float, float]
+Point3 = tuple[float, float, float]
+PositiveTime = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
+Length = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+
+
+class _Record(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+def _segments_cross(a: Point2, b: Point2, c: Point2, d: Point2) -> bool:
+    """True when segments ab and cd properly intersect (touching at shared endpoints is not a crossing)."""
+
+    def orient(p: Point2, q: Point2, r: Point2) -> float:
+        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+
+    o1, o2, o3, o4 = orient(a, b, c), orient(a, b, d), orient(c, d, a), orient(c, d, b)
+    return (o1 * o2 < 0) and (o3 * o4 < 0)
+
+
+def check_simple_polygon(points: tuple[Point2, ...]) -> tuple[Point2, ...]:
+    if len(points) < 3:
+        raise ValueError(f"a polygon needs at least 3 points, got {len(points)}")
+    n = len(points)
+    area2 = sum(points[i][0] * points[(i + 1) % n][1] - points[(i + 1) % n][0] * points[i][1] for i in range(n))
+    if abs(area2) < 1e-12:
+        raise ValueError("the polygon has zero area")
+    for i in range(n):
+        for j in range(i + 1, n):
+            if j in (i, (i + 1) % n) or i == (j + 1) % n:
+                continue
+            if _segments_cross(points[i], points[(i + 1) % n], points[j], points[(j + 1) % n]):
+                raise ValueError(f"the polygon intersects itself (edge {i} crosses edge {j})")
+    return points
+
+
+class Pose(_Record):
+    xyz: Point3 = (0.0, 0.0, 0.0)
+    yaw_deg: float = Field(0.0, allow_inf_nan=False)
+
+
+class CapsuleSpec(_Record):
+    """A capsule fixed to a robot link, in that link's frame."""
+
+    link: str
+    p0: Point3
+    p1: Point3
+    radius: Length
+
+
+class TaskSpec(_Record):
+    """A cyclic pick-and-place: joint waypoints visited in order, then back to the first."""
+
+    waypoints_deg: tuple[tuple[float, ...], ...] = Field(min_length=2)
+    dwell: NonNegative = 0.2
+    speed_scale: Annotated[float, Field(gt=0.0, le=1.0)] = 0.5
+    phase: NonNegative = 0.0
+
+    @field_validator("waypoints_deg")
+    @classmethod
+    def _same_length(cls, v: tuple[tuple[float, ...], ...]) -> tuple[tuple[float, ...], ...]:
+        lengths = {len(w) for w in v}
+        if len(lengths) != 1:
+            raise ValueError(f"all waypoints need the same number of joints, got lengths {sorted(lengths)}")
+        for w in v:
+            if not all(math.isfinite(x) for x in w):
+                raise ValueError("waypoints must be finite numbers")
+        return v
+
+
+class RobotSpec(_Record):
+    urdf: str = "ur10"
+    base: Pose = Pose()
+    capsules: Literal["auto"] | tuple[CapsuleSpec, ...] = "auto"
+    extra_capsules: tuple[CapsuleSpec, ...] = ()
+    stopping_time: PositiveTime = 0.15
+    task: TaskSpec
+
+
+class TableSpec(_Record):
+    height: Length = 0.85
+    polygons: tuple[tuple[Point2, ...], ...] = Field(min_length=1)
+
+    @field_validator("polygons")
+    @classmethod
+    def _simple(cls, v: tuple[tuple[Point2, ...], ...]) -> tuple[tuple[Point2, ...], ...]:
+        return tuple(check_simple_polygon(p) for p in v)
+
+
+class FenceSpec(_Record):
+    """A run of fence panels along a polyline, from ``bottom`` to ``top`` above the floor."""
+
+    points: tuple[Point2, ...] = Field(min_length=2)
+    top: Length = 2.0
+    bottom: NonNegative = 0.0
+
+    @model_validator(mode="after")
+    def _heights(self) -> FenceSpec:
+        if self.top <= self.bottom:
+            raise ValueError(f"top ({self.top}) must be above bottom ({self.bottom})")
+        for a, b in zip(self.points, self.points[1:], strict=False):
+            if a == b:
+                raise ValueError(f"two consecutive points are equal: {a}")
+        return self
+
+
+class FloorSpec(_Record):
+    """The walkable rectangle: the worker cannot leave it."""
+
+    xmin: float
+    xmax: float
+    ymin: float
+    ymax: float
+
+    @model_validator(mode="after")
+    def _ordered(self) -> FloorSpec:
+        if not (self.xmin < self.xmax and self.ymin < self.ymax):
+            raise ValueError("need xmin < xmax and ymin < ymax")
+        return self
+
+
+class LaserScannerSpec(_Record):
+    type: Literal["laser-scanner"]
+    name: str
+    polygon: tuple[Point2, ...]
+    height: Annotated[float, Field(ge=0.0, le=1.0)] = 0.3
+    response_time: PositiveTime = 0.35
+
+    @field_validator("polygon")
+    @classmethod
+    def _simple(cls, v: tuple[Point2, ...]) -> tuple[Point2, ...]:
+        return check_simple_polygon(v)
+
+
+class LightCurtainSpec(_Record):
+    type: Literal["light-curtain"]
+    name: str
+    start: Point2
+    end: Point2
+    bottom: NonNegative = 0.2
+    top: Length = 1.8
+    response_time: PositiveTime = 0.05
+    resolution_mm: Annotated[float, Field(gt=0.0, le=200.0)] = 30.0
+
+    @model_validator(mode="after")
+    def _shape(self) -> LightCurtainSpec:
+        if self.start == self.end:
+            raise ValueError("start and end are the same point")
+        if self.top <= self.bottom:
+            raise ValueError(f"top ({self.top}) must be above bottom ({self.bottom})")
+        return self
+
+
+DeviceSpec = Annotated[LaserScannerSpec | LightCurtainSpec, Field(discriminator="type")]
+
+
+class Anthropometry(_Record):
+    """Body dimensions; defaults are the paper's Table I."""
+
+    height: Annotated[float, Field(gt=1.0, lt=2.5)] = 1.78
+    upper_arm: Length = 0.30
+    forearm: Length = 0.31
+    hand: Length = 0.18
+
+
+class StartSpec(_Record):
+    xy: Point2
+    heading_deg: float = Field(allow_inf_nan=False)
+
+
+class HumanSpec(_Record):
+    start: StartSpec
+    anthropometry: Anthropometry = Anthropometry()
+    walking_speed: Length = 1.6
+    max_forward_flexion_deg: Annotated[float, Field(ge=0.0, le=90.0)] = 55.0
+    max_lateral_flexion_deg: Annotated[float, Field(ge=0.0, le=60.0)] = 35.0
+
+
+class CriterionSpec(_Record):
+    type: Literal["contact-while-moving"] = "contact-while-moving"
+    distance_tolerance: Annotated[float, Field(ge=0.0, le=0.1)] = 0.0
+    speed_tolerance: Annotated[float, Field(ge=0.0, le=0.1)] = 0.001
+
+
+class SimulationSpec(_Record):
+    dt: PositiveTime = 0.05
+    steps_per_action: Annotated[int, Field(ge=1, le=100)] = 4
+    actions_per_episode: Annotated[int, Field(ge=1, le=100)] = 8
+
+
+class CellSpec(_Record):
+    name: str
+    description: str = ""
+    robot: RobotSpec
+    table: TableSpec
+    fences: tuple[FenceSpec, ...] = ()
+    floor: FloorSpec
+    devices: tuple[DeviceSpec, ...] = ()
+    human: HumanSpec
+    criterion: CriterionSpec = CriterionSpec()
+    simulation: SimulationSpec = SimulationSpec()
+
+    @model_validator(mode="after")
+    def _unique_device_names(self) -> CellSpec:
+        names = [d.name for d in self.devices]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise ValueError(f"device names must be unique; repeated: {', '.join(dup)}")
+        return self

@@ -1,0 +1,71 @@
+"""The worker's body: capsules for legs, trunk, head and hanging arms, placed from the body height.
+
+Segment proportions are fractions of body height H from Drillis & Contini (1966) as tabulated in Winter,
+*Biomechanics and Motor Control of Human Movement* (4th ed., Fig. 4.1): hip (greater trochanter) 0.530 H,
+shoulder 0.818 H, chin 0.870 H, shoulder width 0.259 H, hip width 0.191 H. Radii are round numbers for an
+adult man in work clothes (see docs/cells.md). The trunk pivots at the hip: forward flexion about the body's
+left axis, lateral flexion about its forward axis. Legs stay vertical; arms at rest hang straight down.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+BODY_PARTS: tuple[str, ...] = (
+    "left-leg",
+    "right-leg",
+    "trunk",
+    "head",
+    "left-arm",
+    "right-arm",
+    "left-reach",
+    "right-reach",
+)
+N_CAPSULES = 6  # the first six parts are capsules; the last two are the reach volumes
+
+# Indices into the body parameter vector used by the kernel.
+B_HIP_Z, B_SHOULDER_RISE, B_SHOULDER_HALF, B_LEG_HALF, B_HEAD_RISE, B_TRUNK_TOP = range(6)
+B_R_LEG, B_R_TRUNK, B_R_HEAD, B_R_ARM, B_ARM_LEN, B_BODY_RADIUS, B_WALK_SPEED = range(6, 13)
+N_BODY_PARAMS = 13
+
+
+@dataclass(frozen=True)
+class BodyDimensions:
+    height: float
+    upper_arm: float
+    forearm: float
+    hand: float
+    walking_speed: float
+    body_radius: float = 0.20  # footprint radius that keeps the body centre from fences and table edges
+
+    @property
+    def arm_length(self) -> float:
+        return self.upper_arm + self.forearm + self.hand
+
+    @property
+    def hip_height(self) -> float:
+        return 0.530 * self.height
+
+    @property
+    def shoulder_rise(self) -> float:
+        return (0.818 - 0.530) * self.height
+
+    def params(self) -> np.ndarray:
+        h = self.height
+        p = np.zeros(N_BODY_PARAMS)
+        p[B_HIP_Z] = self.hip_height
+        p[B_SHOULDER_RISE] = self.shoulder_rise
+        p[B_SHOULDER_HALF] = 0.259 * h / 2 - 0.05  # shoulder joint centre, inside the deltoid
+        p[B_LEG_HALF] = 0.191 * h / 4  # each leg axis halfway between hip centre and hip side
+        p[B_HEAD_RISE] = (0.935 - 0.530) * h  # head centre between chin (0.870 H) and vertex (1.0 H)
+        p[B_TRUNK_TOP] = (0.818 - 0.530) * h - 0.03
+        p[B_R_LEG] = 0.07
+        p[B_R_TRUNK] = 0.15
+        p[B_R_HEAD] = 0.10
+        p[B_R_ARM] = 0.05
+        p[B_ARM_LEN] = self.arm_length
+        p[B_BODY_RADIUS] = self.body_radius
+        p[B_WALK_SPEED] = self.walking_speed
+        return p

@@ -1,0 +1,195 @@
+"""The reachable workspace of an arm, as a signed distance field in the shoulder frame.
+
+The arm is the 5-DOF model of Klopcar & Lenarcic (2005) used by the paper: shoulder flexion and abduction,
+upper-arm rotation, elbow flexion and wrist flexion, with the paper's segment lengths. Joint ranges are the
+normal adult ranges of motion of the American Academy of Orthopaedic Surgeons (Greene & Heckman 1994), cited
+in docs/cells.md. The workspace is every point the upper arm, forearm or hand can occupy. We rasterise it
+once on a voxel grid (sampling joint space densely), close pinholes left by the sampling, and store the
+signed Euclidean distance to its surface (scipy's exact distance transform). Looking up a point costs one
+trilinear interpolation.
+
+Shoulder frame (right arm): x forward, y to the body's left, z up along the trunk. The left arm is the mirror
+image (y -> -y), so one field serves both.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import tempfile
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+from numba import njit
+
+# Ranges of motion [deg] (AAOS normal values): flexion 180 / extension 60, abduction 180 / adduction 30,
+# internal rotation 70 / external rotation 90, elbow flexion 0..150, wrist flexion 80 / extension 70.
+SHOULDER_FLEXION = (-60.0, 180.0)
+SHOULDER_ABDUCTION = (-30.0, 180.0)
+UPPER_ARM_ROTATION = (-90.0, 70.0)
+ELBOW_FLEXION = (0.0, 150.0)
+WRIST_FLEXION = (-70.0, 80.0)
+JOINT_RANGES_DEG = np.array([SHOULDER_FLEXION, SHOULDER_ABDUCTION, UPPER_ARM_ROTATION, ELBOW_FLEXION, WRIST_FLEXION])
+
+GRID_SPACING = 0.02  # m
+_CACHE_VERSION = 1
+
+
+@njit(cache=True)
+def _rotate(m, axis, angle):
+    """m @ R_axis(angle) in place, for 3x3 m and axis 0 (x), 1 (y) or 2 (z)."""
+    c, s = np.cos(angle), np.sin(angle)
+    i, j = (1, 2) if axis == 0 else ((2, 0) if axis == 1 else (0, 1))
+    for r in range(3):
+        a, b = m[r, i], m[r, j]
+        m[r, i] = c * a + s * b
+        m[r, j] = -s * a + c * b
+
+
+@njit(cache=True)
+def arm_points_into(q, lengths, rot, out):
+    """Elbow, wrist and fingertip of the right arm in the shoulder frame for joint angles q [rad] -> out (3, 3).
+
+    At q = 0 the whole arm hangs straight down (-z). Flexion swings it forward (+x), abduction sideways away
+    from the body (-y), rotation turns it about its own axis, elbow and wrist flex towards the palm side.
+    ``rot`` is 3x3 scratch space.
+    """
+    for r in range(3):
+        for c in range(3):
+            rot[r, c] = 1.0 if r == c else 0.0
+    _rotate(rot, 0, -q[1])
+    _rotate(rot, 1, -q[0])
+    _rotate(rot, 2, q[2])
+    px = py = pz = 0.0
+    for k in range(3):
+        if k == 1:
+            _rotate(rot, 1, -q[3])
+        elif k == 2:
+            _rotate(rot, 1, -q[4])
+        # the segment points along -z of the current frame
+        px -= lengths[k] * rot[0, 2]
+        py -= lengths[k] * rot[1, 2]
+        pz -= lengths[k] * rot[2, 2]
+        out[k, 0], out[k, 1], out[k, 2] = px, py, pz
+
+
+@njit(cache=True)
+def arm_points(q, lengths):
+    out = np.empty((3, 3))
+    arm_points_into(q, lengths, np.empty((3, 3)), out)
+    return out
+
+
+@njit(cache=True)
+def _mark_segment(grid, origin, h, ax, ay, az, bx, by, bz):
+    n = grid.shape[0]
+    length = np.sqrt((bx - ax) ** 2 + (by - ay) ** 2 + (bz - az) ** 2)
+    k = int(length / (0.5 * h)) + 1
+    for i in range(k + 1):
+        f = i / k
+        ix = int(np.floor((ax + (bx - ax) * f - origin) / h + 0.5))
+        iy = int(np.floor((ay + (by - ay) * f - origin) / h + 0.5))
+        iz = int(np.floor((az + (bz - az) * f - origin) / h + 0.5))
+        if 0 <= ix < n and 0 <= iy < n and 0 <= iz < n:
+            grid[ix, iy, iz] = True
+
+
+@njit(cache=True)
+def _rasterise(grid, origin, h, lengths, qs):
+    pts = np.empty((3, 3))
+    rot = np.empty((3, 3))
+    for i in range(qs.shape[0]):
+        arm_points_into(qs[i], lengths, rot, pts)
+        _mark_segment(grid, origin, h, 0.0, 0.0, 0.0, pts[0, 0], pts[0, 1], pts[0, 2])
+        _mark_segment(grid, origin, h, pts[0, 0], pts[0, 1], pts[0, 2], pts[1, 0], pts[1, 1], pts[1, 2])
+        _mark_segment(grid, origin, h, pts[1, 0], pts[1, 1], pts[1, 2], pts[2, 0], pts[2, 1], pts[2, 2])
+
+
+def _joint_samples(step_deg: tuple[float, float, float, float, float]) -> np.ndarray:
+    axes = [np.deg2rad(np.arange(lo, hi + 1e-9, s)) for (lo, hi), s in zip(JOINT_RANGES_DEG, step_deg, strict=True)]
+    for ax, (lo, hi) in zip(axes, np.deg2rad(JOINT_RANGES_DEG), strict=True):
+        ax[-1] = hi  # always include the range ends
+    mesh = np.meshgrid(*axes, indexing="ij")
+    return np.stack([m.ravel() for m in mesh], axis=1)
+
+
+@dataclass(frozen=True)
+class ReachField:
+    """Signed distance [m] to the arm's reachable workspace, on a cube grid in the shoulder frame."""
+
+    values: np.ndarray  # float32 (n, n, n); negative inside
+    origin: float  # coordinate of the first grid node on every axis
+    spacing: float
+    arm_length: float
+
+    @property
+    def nbytes(self) -> int:
+        return int(self.values.nbytes)
+
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """Trilinear lookup for points (m, 3) in the right shoulder frame (reference, not the hot path)."""
+        from cellstress.sim.kernels import reach_lookup
+
+        return np.array([reach_lookup(self.values, self.origin, self.spacing, np.asarray(p, float)) for p in points])
+
+
+def _build(lengths: tuple[float, float, float], spacing: float) -> ReachField:
+    from scipy import ndimage
+
+    reach = float(sum(lengths))
+    half = reach + 3 * spacing
+    n = int(np.ceil(2 * half / spacing)) + 1
+    origin = -0.5 * (n - 1) * spacing
+    occupied = np.zeros((n, n, n), dtype=np.bool_)
+    lengths_arr = np.asarray(lengths, dtype=float)
+    # The whole workspace at a coarse joint step, then the outer shell (straight elbow and wrist, where the
+    # arm reaches furthest) at a step fine enough to leave no gap wider than a voxel at full reach.
+    _rasterise(occupied, origin, spacing, lengths_arr, _joint_samples((6.0, 6.0, 20.0, 10.0, 10.0)))
+    fine = np.rad2deg(spacing / reach) * 0.9
+    shell = _joint_samples((fine, fine, 200.0, 200.0, 200.0))
+    _rasterise(occupied, origin, spacing, lengths_arr, shell)
+    occupied = ndimage.binary_closing(occupied, structure=np.ones((3, 3, 3)), iterations=1)
+    occupied = ndimage.binary_fill_holes(occupied)
+    outside = ndimage.distance_transform_edt(~occupied, sampling=spacing)
+    inside = ndimage.distance_transform_edt(occupied, sampling=spacing)
+    # Voxel centres are samples of a surface that lies half a voxel beyond the outermost occupied centre.
+    sdf = np.where(occupied, -(inside - 0.5 * spacing), outside - 0.5 * spacing).astype(np.float32)
+    return ReachField(sdf, origin, spacing, reach)
+
+
+def _cache_dir() -> Path | None:
+    root = os.environ.get("CELLSTRESS_CACHE") or os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    path = Path(root) / "cellstress"
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return None
+    return path
+
+
+@lru_cache(maxsize=4)
+def reach_field(upper_arm: float, forearm: float, hand: float, spacing: float = GRID_SPACING) -> ReachField:
+    """The field for these segment lengths, built once and kept in memory and in a disk cache."""
+    key = hashlib.sha256(repr((_CACHE_VERSION, upper_arm, forearm, hand, spacing,
+                               JOINT_RANGES_DEG.tolist())).encode()).hexdigest()[:16]
+    cache = _cache_dir()
+    file = cache / f"reach-{key}.npz" if cache else None
+    if file is not None and file.exists():
+        try:
+            with np.load(file) as z:
+                return ReachField(z["values"], float(z["origin"]), float(z["spacing"]), float(z["arm_length"]))
+        except (OSError, ValueError, KeyError):
+            pass  # a damaged cache entry is rebuilt below
+    field = _build((upper_arm, forearm, hand), spacing)
+    if file is not None:
+        try:
+            fd, tmp = tempfile.mkstemp(dir=file.parent, suffix=".npz")
+            with os.fdopen(fd, "wb") as fh:
+                np.savez(fh, values=field.values, origin=field.origin, spacing=field.spacing,
+                         arm_length=field.arm_length)
+            os.replace(tmp, file)
+        except OSError:
+            pass
+    return field

@@ -1,0 +1,141 @@
+"""From a validated Cell to the arrays the compiled simulator runs on."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from cellstress.cell.load import Cell
+from cellstress.human.actions import action_table
+from cellstress.human.body import BodyDimensions
+from cellstress.human.reach import ReachField, reach_field
+from cellstress.robot.capsules import Capsule, declared_capsule, fitted_capsules
+from cellstress.robot.model import RobotModel, load_robot, resolve_urdf
+from cellstress.robot.trajectory import Trajectory, build_trajectory
+from cellstress.sim import kernels as K
+
+SENSE_LATTICE = 0.05  # m; spacing of the points where devices test the reach volumes
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Everything the simulator knows about a cell, with the names that go into reports."""
+
+    cell: Cell
+    robot: RobotModel
+    capsules: tuple[Capsule, ...]
+    trajectory: Trajectory
+    body: BodyDimensions
+    reach: ReachField
+    device_names: tuple[str, ...]
+    params: K.SimParams
+
+
+def _base_matrix(xyz, yaw_deg) -> np.ndarray:
+    c, s = np.cos(np.deg2rad(yaw_deg)), np.sin(np.deg2rad(yaw_deg))
+    m = np.eye(4)
+    m[:3, :3] = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+    m[:3, 3] = xyz
+    return m
+
+
+def _polygons(polys) -> tuple[np.ndarray, np.ndarray]:
+    verts, index = [], []
+    for p in polys:
+        index.append((len(verts), len(p)))
+        verts.extend(p)
+    return np.asarray(verts, dtype=float).reshape(-1, 2), np.asarray(index, dtype=np.int64).reshape(-1, 2)
+
+
+def build_layout(cell: Cell) -> Layout:
+    spec = cell.spec
+    robot = load_robot(resolve_urdf(spec.robot.urdf, cell.directory))
+    if spec.robot.capsules == "auto":
+        caps = list(fitted_capsules(robot))
+    else:
+        caps = [declared_capsule(robot, c.link, c.link, c.p0, c.p1, c.radius) for c in spec.robot.capsules]
+    for i, c in enumerate(spec.robot.extra_capsules):
+        caps.append(declared_capsule(robot, f"{c.link}#extra{i}", c.link, c.p0, c.p1, c.radius))
+    task = spec.robot.task
+    traj = build_trajectory(task.waypoints_deg, task.dwell, task.speed_scale, robot.velocity_limits)
+    anth = spec.human.anthropometry
+    body = BodyDimensions(anth.height, anth.upper_arm, anth.forearm, anth.hand, spec.human.walking_speed)
+    reach = reach_field(anth.upper_arm, anth.forearm, anth.hand)
+
+    nj = robot.n_joints
+    anc = np.zeros((nj, nj))
+    for i in range(nj):
+        j = int(robot.parents[i])
+        while j >= 0:
+            anc[i, j] = 1.0
+            j = int(robot.parents[j])
+
+    fences = [(a[0], a[1], b[0], b[1], f.bottom, f.top)
+              for f in spec.fences for a, b in zip(f.points, f.points[1:], strict=False)]
+    table_verts, table_poly = _polygons(spec.table.polygons)
+
+    kinds, resp, rects, dev_polys = [], [], [], []
+    for d in spec.devices:
+        resp.append(d.response_time)
+        if d.type == "laser-scanner":
+            kinds.append(K.DEV_SCANNER)
+            rects.append((0.0, 0.0, 0.0, 0.0, d.height, d.height))
+            dev_polys.append(d.polygon)
+        else:
+            kinds.append(K.DEV_CURTAIN)
+            rects.append((*d.start, *d.end, d.bottom, d.top))
+            dev_polys.append(())
+    dev_verts, dev_poly = _polygons([p for p in dev_polys])
+
+    scal = np.zeros(K.N_SCAL)
+    scal[K.C_DT] = spec.simulation.dt
+    scal[K.C_STOP_TIME] = spec.robot.stopping_time
+    scal[K.C_PHASE0] = task.phase
+    scal[K.C_CYCLE] = traj.cycle
+    scal[K.C_DWELL] = traj.dwell
+    scal[K.C_DTOL] = spec.criterion.distance_tolerance
+    scal[K.C_VTOL] = spec.criterion.speed_tolerance
+    scal[K.C_REACH_ORIGIN] = reach.origin
+    scal[K.C_REACH_H] = reach.spacing
+    scal[K.C_SENSE_STEP] = SENSE_LATTICE
+
+    params = K.SimParams(
+        scal=scal,
+        spa=int(spec.simulation.steps_per_action),
+        act=action_table(spec.human.max_forward_flexion_deg, spec.human.max_lateral_flexion_deg),
+        body=body.params(),
+        base=_base_matrix(spec.robot.base.xyz, spec.robot.base.yaw_deg),
+        parents=robot.parents.astype(np.int64),
+        placements=np.ascontiguousarray(robot.placements),
+        axes=np.ascontiguousarray(robot.axes),
+        anc=anc,
+        wp=np.ascontiguousarray(traj.waypoints),
+        seg_start=traj.starts.astype(float),
+        seg_move=traj.move_times.astype(float),
+        cap_joint=np.asarray([c.joint for c in caps], dtype=np.int64),
+        cap_a=np.asarray([c.p0 for c in caps], dtype=float).reshape(-1, 3),
+        cap_b=np.asarray([c.p1 for c in caps], dtype=float).reshape(-1, 3),
+        cap_r=np.asarray([c.radius for c in caps], dtype=float),
+        reach=np.ascontiguousarray(reach.values),
+        fences=np.asarray(fences, dtype=float).reshape(-1, 6),
+        table_verts=table_verts,
+        table_poly=table_poly,
+        floor=np.asarray([spec.floor.xmin, spec.floor.xmax, spec.floor.ymin, spec.floor.ymax], dtype=float),
+        dev_kind=np.asarray(kinds, dtype=np.int64),
+        dev_resp=np.asarray(resp, dtype=float),
+        dev_rect=np.asarray(rects, dtype=float).reshape(-1, 6),
+        dev_poly=dev_poly,
+        dev_verts=dev_verts,
+        pre_ra=np.zeros((0, len(caps), 3)),
+        pre_rb=np.zeros((0, len(caps), 3)),
+        pre_v=np.zeros(0),
+        pre_tau=np.zeros(0),
+    )
+    # the robot before any stop, for every step of an episode (and one spare action)
+    n_pre = 1 + spec.simulation.steps_per_action * (spec.simulation.actions_per_episode + 1)
+    pre_ra, pre_rb = np.zeros((n_pre, len(caps), 3)), np.zeros((n_pre, len(caps), 3))
+    pre_v, pre_tau = np.zeros(n_pre), np.zeros(n_pre)
+    K.robot_table(params, n_pre, pre_ra, pre_rb, pre_v, pre_tau)
+    params = params._replace(pre_ra=pre_ra, pre_rb=pre_rb, pre_v=pre_v, pre_tau=pre_tau)
+    return Layout(cell, robot, tuple(caps), traj, body, reach, tuple(d.name for d in spec.devices), params)

@@ -1,0 +1,877 @@
+"""The compiled simulator: one time step of worker, devices and robot, and whole episodes in batches.
+
+Everything here is numba-compiled and works on ``SimParams`` (a named tuple of arrays built once per cell by
+``sim.build``) and a state vector of ``NS`` floats. The step lifecycle follows dm_control's composer:
+move the worker -> sense (devices latch a stop) -> move the robot -> measure.
+
+The robot is a pure function of time and of the moment its stop takes effect: its path time advances one
+second per second until the stop, then slows linearly to a standstill within the stopping time, so
+tau(t) = t_s + d - d^2 / (2 T) for d = t - t_s < T. Nothing is integrated, so nothing drifts.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit, prange
+
+from cellstress.sim.geometry import (
+    point_in_polygon,
+    point_segment_2d,
+    polygon_distance,
+    segment_crosses_rectangle,
+    segment_rectangle,
+    segment_segment,
+)
+
+# ---- state vector -----------------------------------------------------------------------------------------
+S_K, S_X, S_Y, S_HEADING, S_FWD, S_LAT, S_TSTOP, S_TRIG_DEV, S_TRIG_T, S_UNSAFE, S_ACTIONS = range(11)
+NS = 11
+
+# ---- metric row (one per time step) -----------------------------------------------------------------------
+(M_T, M_X, M_Y, M_HEADING, M_FWD, M_LAT, M_D, M_V, M_SEEN, M_PHASE, M_LINK, M_PART,
+ M_RX, M_RY, M_RZ, M_HX, M_HY, M_HZ, M_UNSAFE, M_TAU, M_ACTION, M_STEP) = range(22)
+NM = 22
+
+# stop phases
+PHASE_RUNNING, PHASE_PENDING, PHASE_BRAKING, PHASE_STOPPED = 0, 1, 2, 3
+
+# scalar parameters (P.scal)
+(C_DT, C_STOP_TIME, C_PHASE0, C_CYCLE, C_DWELL, C_DTOL, C_VTOL, C_REACH_ORIGIN, C_REACH_H,
+ C_SENSE_STEP) = range(10)
+N_SCAL = 10
+
+# body parameter indices (mirror cellstress.human.body)
+B_HIP_Z, B_SHOULDER_RISE, B_SHOULDER_HALF, B_LEG_HALF, B_HEAD_RISE, B_TRUNK_TOP = range(6)
+B_R_LEG, B_R_TRUNK, B_R_HEAD, B_R_ARM, B_ARM_LEN, B_BODY_RADIUS, B_WALK_SPEED = range(6, 13)
+N_BODY_CAPSULES = 6
+PART_LEFT_REACH, PART_RIGHT_REACH = 6, 7
+
+DEV_SCANNER, DEV_CURTAIN = 0, 1
+TRACE_REL_TOL = 0.05  # far from contact, d_HR needs only relative accuracy (it feeds a smooth reward)
+WALK_BLOCK_HEIGHT = 0.5  # a panel whose bottom is above this does not stop walking
+
+
+class SimParams(NamedTuple):
+    scal: np.ndarray  # (N_SCAL,)
+    spa: int  # steps per action
+    act: np.ndarray  # (n_actions, 4): walks, heading change, target forward / lateral flexion
+    body: np.ndarray  # body parameters
+    base: np.ndarray  # (4, 4) robot base in the world
+    parents: np.ndarray  # (nj,) int64
+    placements: np.ndarray  # (nj, 4, 4)
+    axes: np.ndarray  # (nj, 3)
+    anc: np.ndarray  # (nj, nj) float: 1 where column joint moves row joint's origin
+    wp: np.ndarray  # (nw, nj) waypoints
+    seg_start: np.ndarray  # (nw,)
+    seg_move: np.ndarray  # (nw,)
+    cap_joint: np.ndarray  # (nc,) int64, -1 = base
+    cap_a: np.ndarray  # (nc, 3)
+    cap_b: np.ndarray  # (nc, 3)
+    cap_r: np.ndarray  # (nc,)
+    reach: np.ndarray  # (n, n, n) float32 signed distance
+    fences: np.ndarray  # (nf, 6) x0 y0 x1 y1 zlo zhi
+    table_verts: np.ndarray  # (V, 2)
+    table_poly: np.ndarray  # (T, 2) int64 start, count
+    floor: np.ndarray  # (4,) xmin xmax ymin ymax
+    dev_kind: np.ndarray  # (nd,) int64
+    dev_resp: np.ndarray  # (nd,)
+    dev_rect: np.ndarray  # (nd, 6) curtain rectangle; for scanners [4] holds the scan height
+    dev_poly: np.ndarray  # (nd, 2) int64 start, count into dev_verts
+    dev_verts: np.ndarray  # (V, 2)
+    pre_ra: np.ndarray  # (n_pre, nc, 3) robot capsules at step k before any stop (a cache: see robot_at)
+    pre_rb: np.ndarray
+    pre_v: np.ndarray  # (n_pre,) v_R
+    pre_tau: np.ndarray  # (n_pre,) path time
+
+
+class Work(NamedTuple):
+    q: np.ndarray
+    qd: np.ndarray
+    rot: np.ndarray
+    pos: np.ndarray
+    ra: np.ndarray
+    rb: np.ndarray
+    ha: np.ndarray
+    hb: np.ndarray
+    hr: np.ndarray
+    sh: np.ndarray
+    tr: np.ndarray
+    near: np.ndarray
+    c1: np.ndarray
+    c2: np.ndarray
+    scratch: np.ndarray
+    v3a: np.ndarray
+    v3b: np.ndarray
+    best_r: np.ndarray
+    best_h: np.ndarray
+    lbs: np.ndarray
+    ts: np.ndarray
+    seg_a: np.ndarray
+    seg_b: np.ndarray
+
+
+@njit(cache=True, error_model="numpy")
+def make_work(P):
+    nj = P.placements.shape[0]
+    nc = P.cap_r.shape[0]
+    return Work(
+        np.zeros(nj), np.zeros(nj), np.zeros((nj, 3, 3)), np.zeros((nj, 3)),
+        np.zeros((nc, 3)), np.zeros((nc, 3)),
+        np.zeros((N_BODY_CAPSULES, 3)), np.zeros((N_BODY_CAPSULES, 3)), np.zeros(N_BODY_CAPSULES),
+        np.zeros((2, 3)), np.zeros((3, 3)), np.zeros(P.fences.shape[0] + 1, dtype=np.int64),
+        np.zeros(3), np.zeros(3), np.zeros((4, 3)), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3),
+        np.zeros(2 * nc), np.zeros(2 * nc), np.zeros(3), np.zeros(3),
+    )
+
+
+# ---- robot ------------------------------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy", inline="always")
+def path_time(P, t, t_stop):
+    """(path time tau, time-scaling sigma = dtau/dt, stop phase) at time t for a stop effective at t_stop."""
+    T = P.scal[C_STOP_TIME]
+    tau0 = P.scal[C_PHASE0]
+    if not t_stop < np.inf:
+        return tau0 + t, 1.0, PHASE_RUNNING
+    if t < t_stop:
+        return tau0 + t, 1.0, PHASE_PENDING
+    d = t - t_stop
+    if d >= T:
+        return tau0 + t_stop + 0.5 * T, 0.0, PHASE_STOPPED
+    return tau0 + t_stop + d - d * d / (2.0 * T), 1.0 - d / T, PHASE_BRAKING
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def joint_trajectory(P, tau, sigma, q, qd):
+    """Joint positions and velocities on the cyclic minimum-jerk path at path time tau."""
+    cycle = P.scal[C_CYCLE]
+    dwell = P.scal[C_DWELL]
+    tc = tau - cycle * np.floor(tau / cycle)
+    nw = P.seg_start.shape[0]
+    i = nw - 1
+    for k in range(1, nw):
+        if tc < P.seg_start[k]:
+            i = k - 1
+            break
+    j = i + 1 if i + 1 < nw else 0
+    T = P.seg_move[i]
+    u = (tc - P.seg_start[i] - dwell) / T
+    nj = q.shape[0]
+    if u <= 0.0:
+        for k in range(nj):
+            q[k] = P.wp[i, k]
+            qd[k] = 0.0
+        return
+    if u > 1.0:
+        u = 1.0
+    s = u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
+    ds = 30.0 * u * u * (1.0 - u) * (1.0 - u) / T * sigma
+    for k in range(nj):
+        dq = P.wp[j, k] - P.wp[i, k]
+        q[k] = P.wp[i, k] + s * dq
+        qd[k] = ds * dq
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def forward_kinematics(P, q, rot, pos):
+    """World rotation and origin of every joint frame."""
+    nj = q.shape[0]
+    m = np.empty((3, 3))
+    for j in range(nj):
+        par = P.parents[j]
+        pl = P.placements[j]
+        # parent frame in the world
+        for r in range(3):
+            for c in range(3):
+                acc = 0.0
+                for k in range(3):
+                    pr = P.base[r, k] if par < 0 else rot[par, r, k]
+                    acc += pr * pl[k, c]
+                m[r, c] = acc
+        for r in range(3):
+            acc = P.base[r, 3] if par < 0 else pos[par, r]
+            for k in range(3):
+                pr = P.base[r, k] if par < 0 else rot[par, r, k]
+                acc += pr * pl[k, 3]
+            pos[j, r] = acc
+        # rotation about the joint axis (Rodrigues)
+        kx, ky, kz = P.axes[j, 0], P.axes[j, 1], P.axes[j, 2]
+        c, s = np.cos(q[j]), np.sin(q[j])
+        v = 1.0 - c
+        r00, r01, r02 = c + kx * kx * v, kx * ky * v - kz * s, kx * kz * v + ky * s
+        r10, r11, r12 = ky * kx * v + kz * s, c + ky * ky * v, ky * kz * v - kx * s
+        r20, r21, r22 = kz * kx * v - ky * s, kz * ky * v + kx * s, c + kz * kz * v
+        for r in range(3):
+            a0, a1, a2 = m[r, 0], m[r, 1], m[r, 2]
+            rot[j, r, 0] = a0 * r00 + a1 * r10 + a2 * r20
+            rot[j, r, 1] = a0 * r01 + a1 * r11 + a2 * r21
+            rot[j, r, 2] = a0 * r02 + a1 * r12 + a2 * r22
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def fastest_joint_speed(P, qd, rot, pos):
+    """v_R: the largest Cartesian speed of any joint origin (the paper's 'fastest robot joint')."""
+    nj = qd.shape[0]
+    best = 0.0
+    for i in range(nj):
+        vx = vy = vz = 0.0
+        for j in range(i):
+            if P.anc[i, j] == 0.0:
+                continue
+            wx = rot[j, 0, 0] * P.axes[j, 0] + rot[j, 0, 1] * P.axes[j, 1] + rot[j, 0, 2] * P.axes[j, 2]
+            wy = rot[j, 1, 0] * P.axes[j, 0] + rot[j, 1, 1] * P.axes[j, 1] + rot[j, 1, 2] * P.axes[j, 2]
+            wz = rot[j, 2, 0] * P.axes[j, 0] + rot[j, 2, 1] * P.axes[j, 1] + rot[j, 2, 2] * P.axes[j, 2]
+            dx, dy, dz = pos[i, 0] - pos[j, 0], pos[i, 1] - pos[j, 1], pos[i, 2] - pos[j, 2]
+            vx += qd[j] * (wy * dz - wz * dy)
+            vy += qd[j] * (wz * dx - wx * dz)
+            vz += qd[j] * (wx * dy - wy * dx)
+        sp = np.sqrt(vx * vx + vy * vy + vz * vz)
+        if sp > best:
+            best = sp
+    return best
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def robot_capsules(P, rot, pos, ra, rb):
+    for c in range(P.cap_r.shape[0]):
+        j = P.cap_joint[c]
+        for r in range(3):
+            ax = P.base[r, 3] if j < 0 else pos[j, r]
+            bx = ax
+            for k in range(3):
+                m = P.base[r, k] if j < 0 else rot[j, r, k]
+                ax += m * P.cap_a[c, k]
+                bx += m * P.cap_b[c, k]
+            ra[c, r] = ax
+            rb[c, r] = bx
+
+
+@njit(cache=True, error_model="numpy")
+def robot_live(P, t, t_stop, W):
+    """Pose the robot at time t: capsules into W.ra/W.rb. Returns (v_R, stop phase, path time)."""
+    tau, sigma, phase = path_time(P, t, t_stop)
+    joint_trajectory(P, tau, sigma, W.q, W.qd)
+    forward_kinematics(P, W.q, W.rot, W.pos)
+    robot_capsules(P, W.rot, W.pos, W.ra, W.rb)
+    return fastest_joint_speed(P, W.qd, W.rot, W.pos), phase, tau
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def robot_at(P, k, t_stop, W):
+    """The robot at step k. Until a stop takes effect every episode moves the robot identically, so those
+    steps come from a table made once per cell by the same code (bit-identical to computing them)."""
+    t = k * P.scal[C_DT]
+    if t < t_stop and k < P.pre_v.shape[0]:
+        for c in range(P.cap_r.shape[0]):
+            for r in range(3):
+                W.ra[c, r] = P.pre_ra[k, c, r]
+                W.rb[c, r] = P.pre_rb[k, c, r]
+        return P.pre_v[k], (PHASE_RUNNING if t_stop == np.inf else PHASE_PENDING), P.pre_tau[k]
+    return robot_live(P, t, t_stop, W)
+
+
+@njit(cache=True, error_model="numpy")
+def robot_table(P, n, ra, rb, v, tau):
+    """Fill the pre-stop robot table for steps 0..n-1."""
+    W = make_work(P)
+    for k in range(n):
+        v[k], _, tau[k] = robot_live(P, k * P.scal[C_DT], np.inf, W)
+        ra[k] = W.ra
+        rb[k] = W.rb
+
+
+# ---- human ------------------------------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy", inline="always")
+def human_pose(P, x, y, heading, fwd, lat, W):
+    """Body capsules (W.ha, W.hb, W.hr), shoulders (W.sh) and trunk frame (W.tr, columns x, y, z)."""
+    b = P.body
+    ch, shh = np.cos(heading), np.sin(heading)
+    cf, sf = np.cos(fwd), np.sin(fwd)
+    cl, sl = np.cos(lat), np.sin(lat)
+    # trunk axes in body coordinates (forward, left, up), then in the world
+    xb0, xb1, xb2 = cf, 0.0, -sf
+    zb0, zb1, zb2 = sf * cl, sl, cf * cl
+    yb0, yb1, yb2 = zb1 * xb2 - zb2 * xb1, zb2 * xb0 - zb0 * xb2, zb0 * xb1 - zb1 * xb0
+    tr = W.tr
+    tr[0, 0], tr[1, 0], tr[2, 0] = xb0 * ch - xb1 * shh, xb0 * shh + xb1 * ch, xb2
+    tr[0, 1], tr[1, 1], tr[2, 1] = yb0 * ch - yb1 * shh, yb0 * shh + yb1 * ch, yb2
+    tr[0, 2], tr[1, 2], tr[2, 2] = zb0 * ch - zb1 * shh, zb0 * shh + zb1 * ch, zb2
+    hz = b[B_HIP_Z]
+    lx, ly = -shh, ch  # body left in the world
+    # legs
+    for k in range(2):
+        sgn = 1.0 if k == 0 else -1.0
+        W.ha[k, 0], W.ha[k, 1], W.ha[k, 2] = x + sgn * b[B_LEG_HALF] * lx, y + sgn * b[B_LEG_HALF] * ly, hz
+        W.hb[k, 0], W.hb[k, 1], W.hb[k, 2] = W.ha[k, 0], W.ha[k, 1], b[B_R_LEG]
+        W.hr[k] = b[B_R_LEG]
+    # trunk and head
+    W.ha[2, 0], W.ha[2, 1], W.ha[2, 2] = x, y, hz
+    for r in range(3):
+        W.hb[2, r] = W.ha[2, r] + b[B_TRUNK_TOP] * tr[r, 2]
+        W.ha[3, r] = W.ha[2, r] + b[B_HEAD_RISE] * tr[r, 2]
+        W.hb[3, r] = W.ha[3, r]
+    W.hr[2] = b[B_R_TRUNK]
+    W.hr[3] = b[B_R_HEAD]
+    # shoulders and hanging arms (left = 0, right = 1)
+    for k in range(2):
+        sgn = 1.0 if k == 0 else -1.0
+        for r in range(3):
+            W.sh[k, r] = W.ha[2, r] + b[B_SHOULDER_RISE] * tr[r, 2] + sgn * b[B_SHOULDER_HALF] * tr[r, 1]
+            W.ha[4 + k, r] = W.sh[k, r]
+            W.hb[4 + k, r] = W.sh[k, r]
+        low = W.sh[k, 2] - (b[B_ARM_LEN] - b[B_R_ARM])
+        W.hb[4 + k, 2] = low if low > b[B_R_ARM] else b[B_R_ARM]
+        W.hr[4 + k] = b[B_R_ARM]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _grid_coord(c, origin, hi, h, n):
+    """(clamped cell index, fraction, squared distance outside the grid) along one axis."""
+    out2 = 0.0
+    if c < origin:
+        out2 = (origin - c) ** 2
+        c = origin
+    elif c > hi:
+        out2 = (c - hi) ** 2
+        c = hi
+    g = (c - origin) / h
+    i = int(g)
+    if i > n - 2:
+        i = n - 2
+    return i, g - i, out2
+
+
+@njit(cache=True, error_model="numpy")
+def reach_lookup(vals, origin, h, p):
+    """Trilinear signed distance at p (shoulder frame); beyond the grid, the distance to it is added."""
+    n = vals.shape[0]
+    hi = origin + (n - 1) * h
+    i, fx, ex = _grid_coord(p[0], origin, hi, h, n)
+    j, fy, ey = _grid_coord(p[1], origin, hi, h, n)
+    k, fz, ez = _grid_coord(p[2], origin, hi, h, n)
+    c00 = vals[i, j, k] * (1 - fx) + vals[i + 1, j, k] * fx
+    c10 = vals[i, j + 1, k] * (1 - fx) + vals[i + 1, j + 1, k] * fx
+    c01 = vals[i, j, k + 1] * (1 - fx) + vals[i + 1, j, k + 1] * fx
+    c11 = vals[i, j + 1, k + 1] * (1 - fx) + vals[i + 1, j + 1, k + 1] * fx
+    c0 = c00 * (1 - fy) + c10 * fy
+    c1 = c01 * (1 - fy) + c11 * fy
+    return c0 * (1 - fz) + c1 * fz + np.sqrt(ex + ey + ez)
+
+
+@njit(cache=True, error_model="numpy")
+def _edge_detour(sx, sy, sz, qx, qy, qz, ex, ey, ez, dx, dy, dz, length):
+    """Shortest path s -> e -> q with e on the edge (ex, ey, ez) + t d, t in [0, length]; returns (len, t)."""
+    ts = (sx - ex) * dx + (sy - ey) * dy + (sz - ez) * dz
+    tq = (qx - ex) * dx + (qy - ey) * dy + (qz - ez) * dz
+    rs = np.sqrt(max(0.0, (sx - ex) ** 2 + (sy - ey) ** 2 + (sz - ez) ** 2 - ts * ts))
+    rq = np.sqrt(max(0.0, (qx - ex) ** 2 + (qy - ey) ** 2 + (qz - ez) ** 2 - tq * tq))
+    t = ts if rs + rq <= 1e-12 else ts + (tq - ts) * rs / (rs + rq)
+    t = 0.0 if t < 0.0 else (length if t > length else t)
+    px, py, pz = ex + t * dx, ey + t * dy, ez + t * dz
+    d1 = np.sqrt((sx - px) ** 2 + (sy - py) ** 2 + (sz - pz) ** 2)
+    d2 = np.sqrt((qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2)
+    return d1 + d2, t
+
+
+@njit(cache=True, error_model="numpy")
+def _path_clear(fences, near, n_near, ax, ay, az, bx, by, bz):
+    """No near fence panel lies across the straight segment a-b."""
+    for m in range(n_near):
+        r = fences[near[m]]
+        ux, uy = r[2] - r[0], r[3] - r[1]
+        nx, ny = -uy, ux
+        sa = (ax - r[0]) * nx + (ay - r[1]) * ny
+        sb = (bx - r[0]) * nx + (by - r[1]) * ny
+        if sa * sb >= 0.0:
+            continue
+        t = sa / (sa - sb)
+        cx, cy, cz = ax + t * (bx - ax), ay + t * (by - ay), az + t * (bz - az)
+        u = ((cx - r[0]) * ux + (cy - r[1]) * uy) / (ux * ux + uy * uy)
+        if 0.0 <= u <= 1.0 and r[4] <= cz <= r[5]:
+            return False
+    return True
+
+
+@njit(cache=True, error_model="numpy")
+def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz):
+    """Length of the shortest arm path from shoulder s to q around the near fence panels, over their top
+    edge or around their ends (inf if every such path is blocked); |s - q| when nothing is in the way."""
+    if _path_clear(fences, near, n_near, sx, sy, sz, qx, qy, qz):
+        return np.sqrt((sx - qx) ** 2 + (sy - qy) ** 2 + (sz - qz) ** 2)
+    best = np.inf
+    nudge = 0.01  # step the bend point off the panel so the crossing tests are not degenerate
+    for m in range(n_near):
+        r = fences[near[m]]
+        ux, uy = r[2] - r[0], r[3] - r[1]
+        w = np.sqrt(ux * ux + uy * uy)
+        ux /= w
+        uy /= w
+        for edge in range(3):
+            if edge == 0:  # top edge
+                length, t = _edge_detour(sx, sy, sz, qx, qy, qz, r[0], r[1], r[5], ux, uy, 0.0, w)
+                ex, ey, ez = r[0] + t * ux, r[1] + t * uy, r[5] + nudge
+            else:  # vertical end edges
+                sgn = -1.0 if edge == 1 else 1.0
+                bx = r[0] if edge == 1 else r[2]
+                by = r[1] if edge == 1 else r[3]
+                length, t = _edge_detour(sx, sy, sz, qx, qy, qz, bx, by, r[4], 0.0, 0.0, 1.0, r[5] - r[4])
+                ex, ey, ez = bx + sgn * nudge * ux, by + sgn * nudge * uy, r[4] + t
+            if (length < best and _path_clear(fences, near, n_near, sx, sy, sz, ex, ey, ez)
+                    and _path_clear(fences, near, n_near, ex, ey, ez, qx, qy, qz)):
+                best = length
+    return best
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def reach_value(P, p, side, W, n_near, local):
+    """Signed distance from p to the reach volume of arm ``side`` (0 left, 1 right), fences respected."""
+    s0, s1, s2 = W.sh[side, 0], W.sh[side, 1], W.sh[side, 2]
+    dx, dy, dz = p[0] - s0, p[1] - s1, p[2] - s2
+    tr = W.tr
+    local[0] = tr[0, 0] * dx + tr[1, 0] * dy + tr[2, 0] * dz
+    ly = tr[0, 1] * dx + tr[1, 1] * dy + tr[2, 1] * dz
+    local[1] = -ly if side == 0 else ly
+    local[2] = tr[0, 2] * dx + tr[1, 2] * dy + tr[2, 2] * dz
+    f = reach_lookup(P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], local)
+    if n_near > 0:
+        detour = fence_detour(P.fences, W.near, n_near, s0, s1, s2, p[0], p[1], p[2])
+        g = detour - P.body[B_ARM_LEN]
+        if g > f:
+            f = g
+    return f
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def near_fences(P, W, margin):
+    """Collect into W.near the fence panels within ``margin`` of either shoulder (plan view)."""
+    n = 0
+    for f in range(P.fences.shape[0]):
+        r = P.fences[f]
+        d0 = point_segment_2d(W.sh[0, 0], W.sh[0, 1], r[0], r[1], r[2], r[3])
+        d1 = point_segment_2d(W.sh[1, 0], W.sh[1, 1], r[0], r[1], r[2], r[3])
+        if d0 < margin or d1 < margin:
+            W.near[n] = f
+            n += 1
+    return n
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def reach_to_segment(P, a, b, r, side, W, n_near, bound, out_q):
+    """min over the capsule axis ab of (reach distance - r), by sphere tracing the 1-Lipschitz field.
+
+    Stops early once the rest of the segment cannot come below ``bound``. The minimum is found to within
+    the field's grid spacing plus TRACE_REL_TOL of the distance. Writes the closest axis point to out_q.
+    """
+    h = P.scal[C_REACH_H]
+    step_cap = np.inf if n_near == 0 else 2.0 * h  # fence detours make the field jump: walk slowly there
+    L = np.sqrt((b[0] - a[0]) ** 2 + (b[1] - a[1]) ** 2 + (b[2] - a[2]) ** 2)
+    p = W.v3a
+    local = W.v3b
+    best = np.inf
+    t = 0.0
+    while True:
+        tt = t / L if L > 0.0 else 0.0
+        for k in range(3):
+            p[k] = a[k] + tt * (b[k] - a[k])
+        f = reach_value(P, p, side, W, n_near, local)
+        if f < best:
+            best = f
+            out_q[0], out_q[1], out_q[2] = p[0], p[1], p[2]
+        if t >= L or f - (L - t) - r >= bound:
+            break
+        # no point within `step` can undercut min(best, bound) by more than the tolerance
+        target = best if best < bound + r else bound + r
+        step = f - target + h + TRACE_REL_TOL * (target if target > 0.0 else 0.0)
+        if step > step_cap:
+            step = step_cap
+        t += step
+        if t > L:
+            t = L
+    return best - r
+
+
+# ---- sensing ----------------------------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy", inline="always")
+def _reach_meets_plane_region(P, d, side, W, n_near):
+    """True when the reach volume of arm ``side`` meets device d's detection region (sampled on a lattice)."""
+    L = P.body[B_ARM_LEN]
+    s = W.sh[side]
+    step = P.scal[C_SENSE_STEP]
+    p = W.c1
+    local = W.c2
+    if P.dev_kind[d] == DEV_SCANNER:
+        H = P.dev_rect[d, 4]
+        dz = s[2] - H
+        if abs(dz) >= L:
+            return False
+        rho = np.sqrt(L * L - dz * dz)
+        n = int(rho / step)
+        start, count = P.dev_poly[d, 0], P.dev_poly[d, 1]
+        for i in range(-n, n + 1):
+            for j in range(-n, n + 1):
+                p[0], p[1], p[2] = s[0] + i * step, s[1] + j * step, H
+                if point_in_polygon(p[0], p[1], P.dev_verts, start, count):
+                    if reach_value(P, p, side, W, n_near, local) <= 0.0:
+                        return True
+        return False
+    r = P.dev_rect[d]
+    ux, uy = r[2] - r[0], r[3] - r[1]
+    w = np.sqrt(ux * ux + uy * uy)
+    ux /= w
+    uy /= w
+    dn = (s[0] - r[0]) * -uy + (s[1] - r[1]) * ux
+    if abs(dn) >= L:
+        return False
+    rho = np.sqrt(L * L - dn * dn)
+    us = (s[0] - r[0]) * ux + (s[1] - r[1]) * uy
+    n = int(rho / step)
+    for i in range(-n, n + 1):
+        u = us + i * step
+        if u < 0.0 or u > w:
+            continue
+        for j in range(-n, n + 1):
+            z = s[2] + j * step
+            if z < r[4] or z > r[5]:
+                continue
+            p[0], p[1], p[2] = r[0] + u * ux, r[1] + u * uy, z
+            if reach_value(P, p, side, W, n_near, local) <= 0.0:
+                return True
+    return False
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def device_sees(P, d, W, n_near):
+    """Does device d detect the worker: a body capsule, or a reach volume, in its detection region?"""
+    if P.dev_kind[d] == DEV_SCANNER:
+        H = P.dev_rect[d, 4]
+        start, count = P.dev_poly[d, 0], P.dev_poly[d, 1]
+        for c in range(N_BODY_CAPSULES):
+            a, b, r = W.ha[c], W.hb[c], W.hr[c]
+            lo, hi = min(a[2], b[2]), max(a[2], b[2])
+            if H < lo - r or H > hi + r:
+                continue
+            if b[2] == a[2]:
+                t = 0.0
+            else:
+                t = (H - a[2]) / (b[2] - a[2])
+                t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
+            px, py, pz = a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])
+            dz = abs(pz - H)
+            if dz > r:
+                continue
+            if polygon_distance(px, py, P.dev_verts, start, count) <= np.sqrt(r * r - dz * dz):
+                return True
+    else:
+        r = P.dev_rect[d]
+        # nothing of the worker (body or reach) is further than this from the hip axis in plan view
+        extent = P.body[B_SHOULDER_HALF] + P.body[B_ARM_LEN] + P.body[B_R_TRUNK] + P.body[B_HEAD_RISE]
+        if point_segment_2d(W.ha[2, 0], W.ha[2, 1], r[0], r[1], r[2], r[3]) > extent:
+            return False
+        for c in range(N_BODY_CAPSULES):
+            if segment_rectangle(W.ha[c], W.hb[c], r, W.c1, W.c2, W.scratch) <= W.hr[c]:
+                return True
+    L = P.body[B_ARM_LEN]
+    for side in range(2):
+        s = W.sh[side]
+        if P.dev_kind[d] == DEV_SCANNER:
+            gap = abs(s[2] - P.dev_rect[d, 4])
+        else:
+            r = P.dev_rect[d]
+            gap = point_segment_2d(s[0], s[1], r[0], r[1], r[2], r[3])
+        if gap < L and _reach_meets_plane_region(P, d, side, W, n_near):
+            return True
+    return False
+
+
+# ---- walking and posture limits ---------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy", inline="always")
+def feet_ok(P, x, y):
+    """The footprint circle stays on the floor, off the table and clear of fence panels."""
+    r = P.body[B_BODY_RADIUS]
+    fl = P.floor
+    if x - r < fl[0] or x + r > fl[1] or y - r < fl[2] or y + r > fl[3]:
+        return False
+    for t in range(P.table_poly.shape[0]):
+        if polygon_distance(x, y, P.table_verts, P.table_poly[t, 0], P.table_poly[t, 1]) < r:
+            return False
+    for f in range(P.fences.shape[0]):
+        fe = P.fences[f]
+        if fe[4] < WALK_BLOCK_HEIGHT and point_segment_2d(x, y, fe[0], fe[1], fe[2], fe[3]) < r:
+            return False
+    return True
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def trunk_clear(P, W):
+    """Trunk and head do not pass through any fence panel (the hands' reach is limited separately)."""
+    extent = P.body[B_HEAD_RISE] + P.body[B_R_HEAD]
+    for f in range(P.fences.shape[0]):
+        fe = P.fences[f]
+        if point_segment_2d(W.ha[2, 0], W.ha[2, 1], fe[0], fe[1], fe[2], fe[3]) > extent:
+            continue
+        for c in (2, 3):
+            if segment_rectangle(W.ha[c], W.hb[c], P.fences[f], W.c1, W.c2, W.scratch) < W.hr[c]:
+                return False
+    return True
+
+
+# ---- measuring --------------------------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy", inline="always")
+def _set_reach_hit(row, q):
+    row[M_RX], row[M_RY], row[M_RZ] = q[0], q[1], q[2]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def separation(P, W, n_near, row):
+    """d_HR: minimum distance between the robot capsules and the body capsules or reach volumes.
+
+    Reach volumes first, nearest (capsule, arm) pair first: they usually hold the minimum, and the bound
+    they give lets most body-capsule pairs be skipped after a one-line test. Writes distance,
+    closest robot capsule, body part and both points into the metric row.
+    """
+    # (Hot loop: index arrays element-wise; slicing a row would create a reference-counted view each time.)
+    best = np.inf
+    best_cap = -1
+    best_part = -1
+    ra, rb, sh = W.ra, W.rb, W.sh
+    q = W.best_r
+    nc = P.cap_r.shape[0]
+    # Reach volumes lie inside the arm-length ball around their shoulder, so |p - s| - L bounds the distance
+    # from below. Visit (capsule, arm) pairs from the smallest bound up; stop when the bound passes the best.
+    L = P.body[B_ARM_LEN] + 2.0 * P.scal[C_REACH_H]
+    lbs = W.lbs
+    ts = W.ts
+    for c in range(nc):
+        abx, aby, abz = rb[c, 0] - ra[c, 0], rb[c, 1] - ra[c, 1], rb[c, 2] - ra[c, 2]
+        ll = abx * abx + aby * aby + abz * abz
+        for side in range(2):
+            sx, sy, sz = sh[side, 0] - ra[c, 0], sh[side, 1] - ra[c, 1], sh[side, 2] - ra[c, 2]
+            t = 0.0 if ll <= 0.0 else (sx * abx + sy * aby + sz * abz) / ll
+            t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
+            px, py, pz = t * abx - sx, t * aby - sy, t * abz - sz
+            lbs[2 * c + side] = np.sqrt(px * px + py * py + pz * pz) - P.cap_r[c] - L
+            ts[2 * c + side] = t
+    pa, pb = W.seg_a, W.seg_b
+    while True:
+        m = -1
+        lo = best
+        for i in range(2 * nc):
+            if lbs[i] < lo:
+                lo = lbs[i]
+                m = i
+        if m < 0:
+            break
+        lbs[m] = np.inf
+        c, side = m // 2, m % 2
+        r = P.cap_r[c]
+        t = ts[m]
+        for k in range(3):
+            W.v3a[k] = ra[c, k] + t * (rb[c, k] - ra[c, k])
+        d = reach_value(P, W.v3a, side, W, n_near, W.v3b) - r
+        if d < best:
+            best, best_cap, best_part = d, c, PART_LEFT_REACH + side
+            _set_reach_hit(row, W.v3a)
+        # trace only the part of the axis within reach of undercutting the best: |p - s| < best + r + L
+        R = best + r + L
+        abx, aby, abz = rb[c, 0] - ra[c, 0], rb[c, 1] - ra[c, 1], rb[c, 2] - ra[c, 2]
+        ll = abx * abx + aby * aby + abz * abz
+        if ll <= 0.0:
+            continue
+        fx, fy, fz = ra[c, 0] - sh[side, 0], ra[c, 1] - sh[side, 1], ra[c, 2] - sh[side, 2]
+        bq = fx * abx + fy * aby + fz * abz
+        cq = fx * fx + fy * fy + fz * fz - R * R
+        disc = bq * bq - ll * cq
+        if disc <= 0.0:
+            continue
+        root = np.sqrt(disc)
+        t0 = (-bq - root) / ll
+        t1 = (-bq + root) / ll
+        t0 = 0.0 if t0 < 0.0 else t0
+        t1 = 1.0 if t1 > 1.0 else t1
+        if t1 <= t0:
+            continue
+        for k in range(3):
+            pa[k] = ra[c, k] + t0 * (rb[c, k] - ra[c, k])
+            pb[k] = ra[c, k] + t1 * (rb[c, k] - ra[c, k])
+        d = reach_to_segment(P, pa, pb, r, side, W, n_near, best, q)
+        if d < best:
+            best, best_cap, best_part = d, c, PART_LEFT_REACH + side
+            _set_reach_hit(row, q)
+    ha, hb, hr = W.ha, W.hb, W.hr
+    for c in range(nc):
+        r = P.cap_r[c]
+        mx, my, mz = 0.5 * (ra[c, 0] + rb[c, 0]), 0.5 * (ra[c, 1] + rb[c, 1]), 0.5 * (ra[c, 2] + rb[c, 2])
+        half = 0.5 * np.sqrt((rb[c, 0] - ra[c, 0]) ** 2 + (rb[c, 1] - ra[c, 1]) ** 2 + (rb[c, 2] - ra[c, 2]) ** 2)
+        for h in range(N_BODY_CAPSULES):
+            hx, hy, hz = 0.5 * (ha[h, 0] + hb[h, 0]), 0.5 * (ha[h, 1] + hb[h, 1]), 0.5 * (ha[h, 2] + hb[h, 2])
+            hh = 0.5 * np.sqrt((hb[h, 0] - ha[h, 0]) ** 2 + (hb[h, 1] - ha[h, 1]) ** 2
+                               + (hb[h, 2] - ha[h, 2]) ** 2)
+            lb = np.sqrt((mx - hx) ** 2 + (my - hy) ** 2 + (mz - hz) ** 2) - half - hh - r - hr[h]
+            if lb >= best:
+                continue
+            d = np.sqrt(segment_segment(ra[c], rb[c], ha[h], hb[h], W.c1, W.c2)) - r - hr[h]
+            if d < best:
+                best, best_cap, best_part = d, c, h
+                row[M_RX], row[M_RY], row[M_RZ] = W.c1[0], W.c1[1], W.c1[2]
+                row[M_HX], row[M_HY], row[M_HZ] = W.c2[0], W.c2[1], W.c2[2]
+    # surface points: step from the axis points towards each other by the radii
+    if best_part >= PART_LEFT_REACH:
+        s = W.sh[best_part - PART_LEFT_REACH]
+        dx, dy, dz = s[0] - row[M_RX], s[1] - row[M_RY], s[2] - row[M_RZ]
+        n = np.sqrt(dx * dx + dy * dy + dz * dz)
+        if n > 0:
+            dx, dy, dz = dx / n, dy / n, dz / n
+        r = P.cap_r[best_cap]
+        row[M_RX], row[M_RY], row[M_RZ] = row[M_RX] + r * dx, row[M_RY] + r * dy, row[M_RZ] + r * dz
+        g = best if best > 0.0 else 0.0
+        row[M_HX], row[M_HY], row[M_HZ] = row[M_RX] + g * dx, row[M_RY] + g * dy, row[M_RZ] + g * dz
+    elif best_part >= 0:
+        dx, dy, dz = row[M_HX] - row[M_RX], row[M_HY] - row[M_RY], row[M_HZ] - row[M_RZ]
+        n = np.sqrt(dx * dx + dy * dy + dz * dz)
+        if n > 0:
+            dx, dy, dz = dx / n, dy / n, dz / n
+        r, hr = P.cap_r[best_cap], W.hr[best_part]
+        row[M_RX], row[M_RY], row[M_RZ] = row[M_RX] + r * dx, row[M_RY] + r * dy, row[M_RZ] + r * dz
+        row[M_HX], row[M_HY], row[M_HZ] = row[M_HX] - hr * dx, row[M_HY] - hr * dy, row[M_HZ] - hr * dz
+    row[M_D] = best if best > 0.0 else 0.0
+    row[M_LINK] = best_cap
+    row[M_PART] = best_part
+    return best
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def sense_and_measure(P, state, W, row, action):
+    """At the state's time: devices latch stops, the robot is posed, d_HR and v_R are measured."""
+    dt = P.scal[C_DT]
+    k = state[S_K]
+    t = k * dt
+    human_pose(P, state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT], W)
+    n_near = near_fences(P, W, P.body[B_ARM_LEN] + 0.05)
+    seen = 0
+    for d in range(P.dev_kind.shape[0]):
+        if device_sees(P, d, W, n_near):
+            seen |= 1 << d
+            t_s = t + P.dev_resp[d]
+            if t_s < state[S_TSTOP]:
+                state[S_TSTOP] = t_s
+                if state[S_TRIG_DEV] < 0:
+                    state[S_TRIG_T] = t
+                state[S_TRIG_DEV] = d
+    v, phase, tau = robot_at(P, int(k), state[S_TSTOP], W)
+    if n_near == 0:
+        # the common case, compiled separately so that the fence-detour code drops out of it
+        d_hr = separation(P, W, 0, row)
+    else:
+        d_hr = separation(P, W, n_near, row)
+    unsafe = d_hr <= P.scal[C_DTOL] and v > P.scal[C_VTOL]
+    row[M_T] = t
+    row[M_X], row[M_Y], row[M_HEADING] = state[S_X], state[S_Y], state[S_HEADING]
+    row[M_FWD], row[M_LAT] = state[S_FWD], state[S_LAT]
+    row[M_V] = v
+    row[M_SEEN] = seen
+    row[M_PHASE] = phase
+    row[M_UNSAFE] = 1.0 if unsafe else 0.0
+    row[M_TAU] = tau
+    row[M_ACTION] = action
+    row[M_STEP] = k
+    if unsafe:
+        state[S_UNSAFE] = 1.0
+    return unsafe
+
+
+@njit(cache=True, error_model="numpy")
+def reset_state(P, x, y, heading, state, W, row):
+    state[:] = 0.0
+    state[S_X], state[S_Y], state[S_HEADING] = x, y, heading
+    state[S_TSTOP] = np.inf
+    state[S_TRIG_DEV] = -1.0
+    state[S_TRIG_T] = -1.0
+    sense_and_measure(P, state, W, row, -1)
+
+
+@njit(cache=True, error_model="numpy")
+def step_action(P, state, action, W, out, row0):
+    """Play one action (P.spa time steps) from ``state`` in place; rows go to out[row0:]. Returns rows written.
+
+    Stops early at the first unsafe step. A state that is already unsafe does not move.
+    """
+    if state[S_UNSAFE] != 0.0:
+        return 0
+    spa = P.spa
+    walks = P.act[action, 0]
+    h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
+    dh = P.act[action, 1]
+    df = P.act[action, 2] - f0
+    dl = P.act[action, 3] - l0
+    stride = P.body[B_WALK_SPEED] * P.scal[C_DT]
+    n = 0
+    for j in range(1, spa + 1):
+        frac = j / spa
+        x, y = state[S_X], state[S_Y]
+        h, f, l = h0 + dh * frac, f0 + df * frac, l0 + dl * frac
+        nx, ny = x, y
+        if walks != 0.0:
+            nx, ny = x + stride * np.cos(h), y + stride * np.sin(h)
+            if not feet_ok(P, nx, ny):
+                nx, ny = x, y
+        human_pose(P, nx, ny, h, f, l, W)
+        if not trunk_clear(P, W):
+            # the new posture would put the trunk through a fence: keep the old posture where it stands
+            human_pose(P, nx, ny, state[S_HEADING], state[S_FWD], state[S_LAT], W)
+            if trunk_clear(P, W):
+                h, f, l = state[S_HEADING], state[S_FWD], state[S_LAT]
+            else:
+                nx, ny, h, f, l = x, y, state[S_HEADING], state[S_FWD], state[S_LAT]
+        state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT] = nx, ny, h, f, l
+        state[S_K] += 1.0
+        unsafe = sense_and_measure(P, state, W, out[row0 + n], action)
+        n += 1
+        if unsafe:
+            break
+    state[S_ACTIONS] += 1.0
+    return n
+
+
+# ---- whole episodes ---------------------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy")
+def run_episode(P, s0, actions, out):
+    """Play ``actions`` from s0; out[0] is the initial row. Returns the number of rows written."""
+    W = make_work(P)
+    state = s0.copy()
+    sense_and_measure(P, state, W, out[0], -1)
+    n = 1
+    for a in range(actions.shape[0]):
+        n += step_action(P, state, actions[a], W, out, n)
+        if state[S_UNSAFE] != 0.0:
+            break
+    return n
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def run_batch(P, s0, actions, d_end, v_end, unsafe_step, min_d):
+    """Many episodes from the same s0. For episode e and action k: d_HR and v_R at the action's end
+    (d_end[e, k], v_end[e, k]; NaN after an unsafe end), unsafe_step[e] the first unsafe time step or -1,
+    min_d[e] the smallest d_HR seen."""
+    n_ep, n_act = actions.shape
+    spa = P.spa
+    for e in prange(n_ep):
+        W = make_work(P)
+        state = s0.copy()
+        rows = np.empty((spa, NM))
+        unsafe_step[e] = -1
+        lo = np.inf
+        for k in range(n_act):
+            n = step_action(P, state, actions[e, k], W, rows, 0)
+            for i in range(n):
+                if rows[i, M_D] < lo:
+                    lo = rows[i, M_D]
+            d_end[e, k] = rows[n - 1, M_D]
+            v_end[e, k] = rows[n - 1, M_V]
+            if state[S_UNSAFE] != 0.0:
+                unsafe_step[e] = int(state[S_K])
+                for kk in range(k + 1, n_act):
+                    d_end[e, kk] = np.nan
+                    v_end[e, kk] = np.nan
+                break
+        min_d[e] = lo

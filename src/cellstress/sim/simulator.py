@@ -1,0 +1,176 @@
+"""The public simulator: reset, step, snapshot/restore, whole episodes and batches.
+
+A state is a small float64 array (``NS`` entries): copying it is a snapshot. ``step`` never changes the
+state it is given, so a search tree can keep states in its nodes and branch from any of them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from cellstress.cell.load import Cell, load_cell
+from cellstress.human.actions import ACTION_NAMES, N_ACTIONS, action_index
+from cellstress.human.body import BODY_PARTS
+from cellstress.sim import kernels as K
+from cellstress.sim.build import Layout, build_layout
+
+STOP_PHASES = ("running", "stop-pending", "braking", "stopped")
+
+
+@dataclass(frozen=True)
+class Trace:
+    """Per-step metrics of an episode: ``rows[i]`` follows kernels.M_*; row 0 is the initial state."""
+
+    rows: np.ndarray
+    actions: tuple[int, ...]
+    layout: Layout
+
+    @property
+    def unsafe(self) -> bool:
+        return bool(self.rows[-1, K.M_UNSAFE])
+
+    @property
+    def unsafe_row(self) -> int | None:
+        hits = np.flatnonzero(self.rows[:, K.M_UNSAFE])
+        return int(hits[0]) if hits.size else None
+
+    def record(self, i: int) -> dict:
+        return step_record(self.rows[i], self.layout)
+
+    def records(self) -> list[dict]:
+        return [step_record(r, self.layout) for r in self.rows]
+
+
+def step_record(row: np.ndarray, layout: Layout) -> dict:
+    """One metric row as named, JSON-ready values."""
+    seen = int(row[K.M_SEEN])
+    link = int(row[K.M_LINK])
+    part = int(row[K.M_PART])
+    act = int(row[K.M_ACTION])
+    return {
+        "step": int(row[K.M_STEP]),
+        "t": float(row[K.M_T]),
+        "action": ACTION_NAMES[act] if act >= 0 else None,
+        "x": float(row[K.M_X]),
+        "y": float(row[K.M_Y]),
+        "heading_deg": float(np.rad2deg(row[K.M_HEADING])),
+        "forward_flexion_deg": float(np.rad2deg(row[K.M_FWD])),
+        "lateral_flexion_deg": float(np.rad2deg(row[K.M_LAT])),
+        "d_HR": float(row[K.M_D]),
+        "v_R": float(row[K.M_V]),
+        "devices": [n for i, n in enumerate(layout.device_names) if seen >> i & 1],
+        "stop_phase": STOP_PHASES[int(row[K.M_PHASE])],
+        "robot_link": layout.capsules[link].name if link >= 0 else None,
+        "body_part": BODY_PARTS[part] if part >= 0 else None,
+        "robot_point": [float(v) for v in row[K.M_RX:K.M_RZ + 1]],
+        "human_point": [float(v) for v in row[K.M_HX:K.M_HZ + 1]],
+        "unsafe": bool(row[K.M_UNSAFE]),
+    }
+
+
+@dataclass(frozen=True)
+class BatchResult:
+    """Summary of many episodes: per action end d_HR / v_R (NaN after the episode ended unsafe)."""
+
+    d_end: np.ndarray
+    v_end: np.ndarray
+    unsafe_step: np.ndarray
+    min_d: np.ndarray
+
+    @property
+    def unsafe(self) -> np.ndarray:
+        return self.unsafe_step >= 0
+
+
+class Simulator:
+    """The cell's physics. ``Simulator("s1-scanner-width")`` or ``Simulator(load_cell(path))``."""
+
+    def __init__(self, cell: Cell | str | Path):
+        if not isinstance(cell, Cell):
+            cell = load_cell(cell)
+        self.layout = build_layout(cell)
+        self.params = self.layout.params
+        self._work = K.make_work(self.params)
+        start = cell.spec.human.start
+        self._s0 = np.zeros(K.NS)
+        self._row0 = np.zeros(K.NM)
+        K.reset_state(self.params, float(start.xy[0]), float(start.xy[1]), float(np.deg2rad(start.heading_deg)),
+                      self._s0, self._work, self._row0)
+        self._s0.setflags(write=False)
+        self._rows = np.zeros((self.params.spa, K.NM))
+
+    # ---- facts ------------------------------------------------------------------------------------------
+    @property
+    def cell(self) -> Cell:
+        return self.layout.cell
+
+    @property
+    def n_actions(self) -> int:
+        return N_ACTIONS
+
+    @property
+    def steps_per_action(self) -> int:
+        return self.params.spa
+
+    @property
+    def actions_per_episode(self) -> int:
+        return self.cell.spec.simulation.actions_per_episode
+
+    @property
+    def dt(self) -> float:
+        return float(self.params.scal[K.C_DT])
+
+    # ---- stepping ---------------------------------------------------------------------------------------
+    def reset(self) -> np.ndarray:
+        """The initial state s0 (a fresh, writable copy)."""
+        return self._s0.copy()
+
+    def initial_metrics(self) -> np.ndarray:
+        return self._row0.copy()
+
+    def step(self, state: np.ndarray, action: int | str) -> tuple[np.ndarray, np.ndarray]:
+        """Play one action from ``state``: (next state, metric rows of its time steps)."""
+        a = action if type(action) is int and 0 <= action < N_ACTIONS else action_index(action)
+        nxt = state.copy()
+        n = K.step_action(self.params, nxt, a, self._work, self._rows, 0)
+        return nxt, self._rows[:n].copy()
+
+    @staticmethod
+    def is_unsafe(state: np.ndarray) -> bool:
+        return state[K.S_UNSAFE] != 0.0
+
+    @staticmethod
+    def time(state: np.ndarray) -> float:
+        return float(state[K.S_K])
+
+    @staticmethod
+    def snapshot(state: np.ndarray) -> bytes:
+        return state.tobytes()
+
+    @staticmethod
+    def restore(snapshot: bytes) -> np.ndarray:
+        return np.frombuffer(snapshot, dtype=np.float64).copy()
+
+    # ---- episodes ---------------------------------------------------------------------------------------
+    def run(self, actions) -> Trace:
+        """Play a whole action sequence from s0 (stopping at the first unsafe step)."""
+        acts = np.asarray([action_index(a) for a in actions], dtype=np.int64)
+        out = np.zeros((1 + len(acts) * self.params.spa, K.NM))
+        n = K.run_episode(self.params, self._s0, acts, out)
+        return Trace(out[:n], tuple(int(a) for a in acts), self.layout)
+
+    def run_batch(self, actions: np.ndarray) -> BatchResult:
+        """Many episodes at once on all cores; ``actions`` is (episodes, actions) of action indices."""
+        acts = np.ascontiguousarray(actions, dtype=np.int64)
+        if acts.ndim != 2 or acts.size and (acts.min() < 0 or acts.max() >= N_ACTIONS):
+            raise ValueError("actions must be a 2-D array of indices in 0..29")
+        n_ep, n_act = acts.shape
+        d_end = np.empty((n_ep, n_act))
+        v_end = np.empty((n_ep, n_act))
+        unsafe_step = np.empty(n_ep, dtype=np.int64)
+        min_d = np.empty(n_ep)
+        K.run_batch(self.params, self._s0, acts, d_end, v_end, unsafe_step, min_d)
+        return BatchResult(d_end, v_end, unsafe_step, min_d)
