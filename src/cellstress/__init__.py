@@ -2,9 +2,25 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 __version__ = "0.1.0"
 
-from cellstress.cell.load import BUILTIN_CELLS, Cell, load_cell  # noqa: E402
-from cellstress.sim.simulator import Simulator  # noqa: E402
-
 __all__ = ["BUILTIN_CELLS", "Cell", "Simulator", "__version__", "load_cell"]
+
+if TYPE_CHECKING:
+    from cellstress.cell.load import BUILTIN_CELLS, Cell, load_cell
+    from cellstress.sim.simulator import Simulator
+
+
+def __getattr__(name: str):
+    # Imported on first use: the simulator pulls in numba, and the command line should start fast.
+    if name in ("BUILTIN_CELLS", "Cell", "load_cell"):
+        from cellstress.cell import load
+
+        return getattr(load, name)
+    if name == "Simulator":
+        from cellstress.sim.simulator import Simulator
+
+        return Simulator
+    raise AttributeError(f"module 'cellstress' has no attribute {name!r}")

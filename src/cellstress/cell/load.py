@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import difflib
 import hashlib
+import types
+import typing
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
 import yaml
-from pydantic import ValidationError
+from pydantic import BaseModel, ValidationError
 
 from cellstress.cell.schema import CellSpec
 from cellstress.errors import CellError
@@ -30,8 +33,48 @@ class Cell:
         return self.spec.name
 
 
-def _builtin_text(name: str) -> str:
-    return resources.files("cellstress.cell").joinpath("builtin").joinpath(f"{name}.yaml").read_text(encoding="utf-8")
+def _builtin_path(name: str):
+    return resources.files("cellstress.cell").joinpath("builtin").joinpath(f"{name}.yaml")
+
+
+def builtin_text(name: str) -> str:
+    """The YAML text of a built-in cell; CellError when its file is missing from the installation."""
+    path = _builtin_path(name)
+    try:
+        return path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise CellError(name, "", f"the built-in cell's file is missing from the installation ({path})") \
+            from None
+
+
+class _CellLoader(yaml.SafeLoader):
+    """PyYAML's safe loader (plain data only, no Python tags) that also rejects repeated keys."""
+
+    def construct_mapping(self, node, deep=False):
+        seen: dict = {}
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=True)
+            try:
+                if key in seen:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"duplicate key {key!r} (first at line {seen[key].line + 1})",
+                        key_node.start_mark)
+                seen[key] = key_node.start_mark
+            except TypeError:  # an unhashable key: let the base class report it
+                pass
+        return super().construct_mapping(node, deep=deep)
+
+
+def safe_load_yaml(text: str):
+    """Parse YAML as plain data (never Python objects), rejecting duplicate keys."""
+    return yaml.load(text, Loader=_CellLoader)  # noqa: S506 - _CellLoader is a SafeLoader
+
+
+# pydantic puts the tag of a tagged-union branch into an error's location; it is not a field name
+_UNION_TAGS = {"laser-scanner", "light-curtain", "capsules-auto", "capsules-list", "function-after",
+               "function-before"}
+_TYPE_WORDS = {"list": "list", "str": "single text value", "int": "single number", "float": "single number",
+               "bool": "single true/false value"}
 
 
 def _field_path(loc: tuple) -> str:
@@ -39,37 +82,164 @@ def _field_path(loc: tuple) -> str:
     for item in loc:
         if isinstance(item, int):
             parts.append(f"[{item}]")
-        elif item in ("laser-scanner", "light-curtain", "function-after", "function-before"):
+        elif item in _UNION_TAGS:
             continue  # pydantic's tag for the union branch, not a field
         else:
             parts.append(("." if parts else "") + str(item))
     return "".join(parts)
 
 
+def _model_at(loc: tuple) -> type[BaseModel] | None:
+    """The schema record at ``loc`` (a pydantic error location), or None when it cannot be followed."""
+    tp: object = CellSpec
+    for item in loc:
+        tp = _unwrap(tp, item)
+        if item in _UNION_TAGS:
+            continue  # _unwrap picked the branch
+        if isinstance(item, int):
+            args = typing.get_args(tp)
+            if typing.get_origin(tp) is not tuple or not args:
+                return None
+            if len(args) == 2 and args[1] is Ellipsis:
+                tp = args[0]
+            else:
+                tp = args[item] if item < len(args) else None
+        elif isinstance(tp, type) and issubclass(tp, BaseModel) and item in tp.model_fields:
+            tp = tp.model_fields[item].annotation
+        else:
+            return None
+    tp = _unwrap(tp, None)
+    return tp if isinstance(tp, type) and issubclass(tp, BaseModel) else None
+
+
+def _unwrap(tp: object, item) -> object:
+    """Strip Annotated; pick the union branch a location item points into (by tag, or the only container)."""
+    while True:
+        origin = typing.get_origin(tp)
+        if origin is typing.Annotated:
+            tp = typing.get_args(tp)[0]
+        elif origin in (typing.Union, types.UnionType):
+            branches = [_unwrap(a, None) for a in typing.get_args(tp)]
+            records = [b for b in branches if isinstance(b, type) and issubclass(b, BaseModel)]
+            tagged = [b for b in records if "type" in b.model_fields
+                      and typing.get_args(b.model_fields["type"].annotation) == (item,)]
+            if tagged:
+                return tagged[0]
+            containers = records + [b for b in branches if typing.get_origin(b) is tuple]
+            if len(containers) != 1:
+                return None
+            tp = containers[0]
+        else:
+            return tp
+
+
+def _unknown_field_message(loc: tuple) -> str:
+    model = _model_at(loc[:-1])
+    if model is None or not isinstance(loc[-1], str):
+        return "unknown field"
+    allowed = list(model.model_fields)
+    close = difflib.get_close_matches(loc[-1], allowed, n=1)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    return f"unknown field; {hint}allowed here: {', '.join(allowed)}"
+
+
+def _describe(value: object) -> str:
+    if value is None:
+        return "nothing (null)"
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _validation_problem(err: dict) -> tuple[str, str]:
+    """(field path, problem) for one pydantic error, worded for a person editing the YAML file."""
+    loc, kind, msg = tuple(err["loc"]), err["type"], err["msg"]
+    ctx = err.get("ctx") or {}
+    value = err.get("input")
+    msg = msg.removeprefix("Value error, ")
+    if kind == "extra_forbidden":
+        return _field_path(loc), _unknown_field_message(loc)
+    if kind == "missing" and _is_short_tuple(err):
+        # a fixed-size tuple (a point) given too few numbers; _merge_short_tuples put the size into ctx
+        return _field_path(loc[:-1]), f"needs {ctx.get('expected', loc[-1] + 1)} values, got {len(value)}"
+    if kind == "missing":
+        return _field_path(loc), "required field is missing"
+    if kind == "too_long" and ctx.get("field_type") == "Tuple":
+        expected, got = ctx.get("max_length"), ctx.get("actual_length")
+        return _field_path(loc), f"has too many values: expected {expected}, got {got}"
+    if kind == "too_short" and ctx.get("field_type") == "Tuple":
+        expected, got = ctx.get("min_length"), ctx.get("actual_length")
+        return _field_path(loc), f"needs at least {expected} items, got {got}"
+    if kind == "union_tag_invalid":
+        tag, expected = ctx.get("tag"), ctx.get("expected_tags", "")
+        return _field_path(loc + ("type",)), f"unknown device type {tag!r}; expected one of {expected}"
+    if kind == "union_tag_not_found":
+        return (_field_path(loc + ("type",)),
+                "required field is missing (the device type: 'laser-scanner' or 'light-curtain')")
+    if kind == "literal_error" and loc and loc[-1] == "capsules-auto":
+        return _field_path(loc), f"must be 'auto' or a list of capsules, got {_describe(value)}"
+    if kind in ("tuple_type", "list_type"):
+        return _field_path(loc), f"should be a list, got {_describe(value)}"
+    if kind in ("model_type", "model_attributes_type", "dict_type"):
+        return _field_path(loc), f"should be a mapping of fields (key: value), got {_describe(value)}"
+    if kind == "invalid_key":
+        return _field_path(loc[:-1]) or "(top level)", f"field names must be text, got {_describe(loc[-1])}"
+    if isinstance(value, (int, float, str, bool)) and kind not in ("value_error", "assertion_error"):
+        msg += f" (got {_describe(value)})"
+    return _field_path(loc), msg
+
+
+def _is_short_tuple(err: dict) -> bool:
+    loc = tuple(err["loc"])
+    return (err["type"] == "missing" and bool(loc) and isinstance(loc[-1], int)
+            and isinstance(err.get("input"), (list, tuple)))
+
+
+def _merge_short_tuples(errors: list[dict]) -> list[dict]:
+    """pydantic reports each absent position of a too-short fixed tuple; keep one error holding the size."""
+    out: list[dict] = []
+    for e in errors:
+        if _is_short_tuple(e) and out and _is_short_tuple(out[-1]) and out[-1]["loc"][:-1] == e["loc"][:-1]:
+            out[-1]["ctx"]["expected"] = e["loc"][-1] + 1
+            continue
+        if _is_short_tuple(e):
+            e = {**e, "ctx": {"expected": e["loc"][-1] + 1}}
+        out.append(e)
+    return out
+
+
+def _follow_on(err: dict) -> bool:
+    """pydantic drops invalid items and then reports the list as too short: an echo of the item's error."""
+    value, ctx = err.get("input"), err.get("ctx") or {}
+    return (err["type"] == "too_short" and isinstance(value, (list, tuple))
+            and len(value) >= ctx.get("min_length", 0))
+
+
 def parse_cell(text: str, source: str, directory: Path | None) -> Cell:
     try:
-        data = yaml.safe_load(text)
+        data = safe_load_yaml(text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "YAML"
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise CellError(source, where, f"YAML syntax error: {problem}") from None
+        if isinstance(exc, yaml.constructor.ConstructorError) and "constructor for the tag" in problem:
+            tag = problem.split("tag", 1)[1].strip().strip("'").replace("tag:yaml.org,2002:", "!!")
+            raise CellError(source, where, f"YAML tag {tag} is not allowed: a cell file holds plain data "
+                                           "(mappings, lists, numbers, text)") from None
+        kind = "YAML error" if isinstance(exc, yaml.constructor.ConstructorError) else "YAML syntax error"
+        raise CellError(source, where, f"{kind}: {problem}") from None
     if data is None:
         raise CellError(source, "", "the file is empty")
     if not isinstance(data, dict):
-        raise CellError(source, "", f"a cell file holds a mapping of fields, not a {type(data).__name__}")
+        what = _TYPE_WORDS.get(type(data).__name__, type(data).__name__)
+        raise CellError(source, "(top level)",
+                        f"a cell file holds a mapping of fields (name: ..., robot: ...), not a {what}")
     try:
         spec = CellSpec.model_validate(data)
     except ValidationError as exc:
-        err = exc.errors()[0]
-        msg = err["msg"]
-        if err["type"] == "extra_forbidden":
-            msg = "unknown field"
-        elif err["type"] == "missing":
-            msg = "required field is missing"
-        msg = msg.removeprefix("Value error, ")
-        more = f" (and {exc.error_count() - 1} more problem(s))" if exc.error_count() > 1 else ""
-        raise CellError(source, _field_path(err["loc"]), msg + more) from None
+        errors = _merge_short_tuples([e for e in exc.errors() if not _follow_on(e)] or exc.errors())
+        field, msg = _validation_problem(errors[0])
+        more = f" (and {len(errors) - 1} more problem(s))" if len(errors) > 1 else ""
+        raise CellError(source, field, msg + more) from None
     cell = Cell(spec, source, directory, hashlib.sha256(text.encode()).hexdigest())
     check_geometry(cell)
     return cell
@@ -79,7 +249,7 @@ def load_cell(name_or_path: str | Path) -> Cell:
     """A built-in cell by name (see ``BUILTIN_CELLS``) or a cell file by path."""
     ref = str(name_or_path)
     if ref in BUILTIN_CELLS:
-        return parse_cell(_builtin_text(ref), ref, None)
+        return parse_cell(builtin_text(ref), ref, None)
     path = Path(ref).expanduser()
     if not path.exists():
         known = ", ".join(BUILTIN_CELLS)
@@ -87,11 +257,16 @@ def load_cell(name_or_path: str | Path) -> Cell:
     if path.is_dir():
         raise CellError(ref, "", "is a directory, not a cell file")
     try:
-        text = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError:
-        raise CellError(ref, "", "is not a UTF-8 text file") from None
+        raw = path.read_bytes()
     except OSError as exc:
         raise CellError(ref, "", f"cannot be read: {exc.strerror}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise CellError(ref, f"line {line}, column {column}",
+                        f"is not UTF-8 text (byte 0x{raw[exc.start]:02x}); save the file as UTF-8") from None
     return parse_cell(text, ref, path.resolve().parent)
 
 
@@ -119,20 +294,24 @@ def check_geometry(cell: Cell) -> None:
     caps = spec.robot.capsules if spec.robot.capsules != "auto" else ()
     for i, c in enumerate(tuple(caps) + spec.robot.extra_capsules):
         if c.link not in robot.link_joint:
-            field = f"robot.capsules[{i}].link" if i < len(caps) else f"robot.extra_capsules[{i - len(caps)}].link"
-            raise CellError(src, field, f"the robot has no link {c.link!r}")
+            field = (f"robot.capsules[{i}].link" if i < len(caps)
+                     else f"robot.extra_capsules[{i - len(caps)}].link")
+            raise CellError(src, field, f"the robot has no link {c.link!r}; its links are "
+                                        f"{', '.join(sorted(robot.link_joint))}")
     import numpy as np
 
     x, y = spec.human.start.xy
     r = 0.20
     fl = spec.floor
+    where = "human.start.xy"
     if not (fl.xmin + r <= x <= fl.xmax - r and fl.ymin + r <= y <= fl.ymax - r):
-        raise CellError(src, "human.start.xy", f"({x}, {y}) is not on the floor (with the body's 0.2 m radius)")
+        raise CellError(src, where, f"({x}, {y}) is not on the floor x {fl.xmin}..{fl.xmax}, "
+                                    f"y {fl.ymin}..{fl.ymax} (keeping the body's {r} m radius inside)")
     for i, poly in enumerate(spec.table.polygons):
         verts = np.asarray(poly, dtype=float)
         if polygon_distance(x, y, verts, 0, len(verts)) < r:
-            raise CellError(src, "human.start.xy", f"({x}, {y}) is inside or touching table polygon {i}")
+            raise CellError(src, where, f"({x}, {y}) is inside or touching the table (table.polygons[{i}])")
     for i, fence in enumerate(spec.fences):
         for a, b in zip(fence.points, fence.points[1:], strict=False):
             if fence.bottom < 0.5 and point_segment_2d(x, y, a[0], a[1], b[0], b[1]) < r:
-                raise CellError(src, "human.start.xy", f"({x}, {y}) is inside or touching fence {i}")
+                raise CellError(src, where, f"({x}, {y}) is inside or touching a fence (fences[{i}])")

@@ -9,10 +9,20 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Discriminator,
+    Field,
+    Tag,
+    field_validator,
+    model_validator,
+)
 
-Point2 = tuple[float, float]
-Point3 = tuple[float, float, float]
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Point2 = tuple[Finite, Finite]
+Point3 = tuple[Finite, Finite, Finite]
 PositiveTime = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
 Length = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
@@ -36,16 +46,23 @@ def check_simple_polygon(points: tuple[Point2, ...]) -> tuple[Point2, ...]:
     if len(points) < 3:
         raise ValueError(f"a polygon needs at least 3 points, got {len(points)}")
     n = len(points)
-    area2 = sum(points[i][0] * points[(i + 1) % n][1] - points[(i + 1) % n][0] * points[i][1] for i in range(n))
-    if abs(area2) < 1e-12:
-        raise ValueError("the polygon has zero area")
+    # crossings first: a symmetric bow-tie has zero signed area, and "intersects itself" is the real problem
     for i in range(n):
         for j in range(i + 1, n):
             if j in (i, (i + 1) % n) or i == (j + 1) % n:
                 continue
             if _segments_cross(points[i], points[(i + 1) % n], points[j], points[(j + 1) % n]):
-                raise ValueError(f"the polygon intersects itself (edge {i} crosses edge {j})")
+                raise ValueError(f"the polygon intersects itself (edge {i} from point {i} crosses edge {j} "
+                                 f"from point {j})")
+    area2 = sum(points[i][0] * points[(i + 1) % n][1] - points[(i + 1) % n][0] * points[i][1]
+                for i in range(n))
+    if abs(area2) < 1e-12:
+        raise ValueError("the polygon has zero area")
     return points
+
+
+# A simple polygon; validated per polygon so that errors name the polygon's index (table.polygons[1]).
+Polygon = Annotated[tuple[Point2, ...], AfterValidator(check_simple_polygon)]
 
 
 class Pose(_Record):
@@ -82,10 +99,22 @@ class TaskSpec(_Record):
         return v
 
 
+def _capsules_kind(v: object) -> str:
+    return "capsules-auto" if isinstance(v, str) else "capsules-list"
+
+
+# "auto" or a list of capsules; the discriminator keeps pydantic from reporting both union branches.
+CapsulesField = Annotated[
+    Annotated[Literal["auto"], Tag("capsules-auto")]
+    | Annotated[tuple[CapsuleSpec, ...], Tag("capsules-list")],
+    Discriminator(_capsules_kind),
+]
+
+
 class RobotSpec(_Record):
     urdf: str = "ur10"
     base: Pose = Pose()
-    capsules: Literal["auto"] | tuple[CapsuleSpec, ...] = "auto"
+    capsules: CapsulesField = "auto"
     extra_capsules: tuple[CapsuleSpec, ...] = ()
     stopping_time: PositiveTime = 0.15
     task: TaskSpec
@@ -93,12 +122,7 @@ class RobotSpec(_Record):
 
 class TableSpec(_Record):
     height: Length = 0.85
-    polygons: tuple[tuple[Point2, ...], ...] = Field(min_length=1)
-
-    @field_validator("polygons")
-    @classmethod
-    def _simple(cls, v: tuple[tuple[Point2, ...], ...]) -> tuple[tuple[Point2, ...], ...]:
-        return tuple(check_simple_polygon(p) for p in v)
+    polygons: tuple[Polygon, ...] = Field(min_length=1)
 
 
 class FenceSpec(_Record):
@@ -121,10 +145,10 @@ class FenceSpec(_Record):
 class FloorSpec(_Record):
     """The walkable rectangle: the worker cannot leave it."""
 
-    xmin: float
-    xmax: float
-    ymin: float
-    ymax: float
+    xmin: Finite
+    xmax: Finite
+    ymin: Finite
+    ymax: Finite
 
     @model_validator(mode="after")
     def _ordered(self) -> FloorSpec:
@@ -136,14 +160,9 @@ class FloorSpec(_Record):
 class LaserScannerSpec(_Record):
     type: Literal["laser-scanner"]
     name: str
-    polygon: tuple[Point2, ...]
+    polygon: Polygon
     height: Annotated[float, Field(ge=0.0, le=1.0)] = 0.3
     response_time: PositiveTime = 0.35
-
-    @field_validator("polygon")
-    @classmethod
-    def _simple(cls, v: tuple[Point2, ...]) -> tuple[Point2, ...]:
-        return check_simple_polygon(v)
 
 
 class LightCurtainSpec(_Record):
@@ -214,10 +233,13 @@ class CellSpec(_Record):
     criterion: CriterionSpec = CriterionSpec()
     simulation: SimulationSpec = SimulationSpec()
 
-    @model_validator(mode="after")
-    def _unique_device_names(self) -> CellSpec:
-        names = [d.name for d in self.devices]
-        dup = sorted({n for n in names if names.count(n) > 1})
-        if dup:
-            raise ValueError(f"device names must be unique; repeated: {', '.join(dup)}")
-        return self
+    @field_validator("devices")
+    @classmethod
+    def _unique_device_names(cls, v: tuple[DeviceSpec, ...]) -> tuple[DeviceSpec, ...]:
+        first: dict[str, int] = {}
+        for i, d in enumerate(v):
+            if d.name in first:
+                raise ValueError(f"device names must be unique: devices[{first[d.name]}] and devices[{i}] "
+                                 f"are both named {d.name!r}")
+            first[d.name] = i
+        return v

@@ -15,9 +15,6 @@ from cellstress.robot.model import RobotModel, load_robot, resolve_urdf
 from cellstress.robot.trajectory import Trajectory, build_trajectory
 from cellstress.sim import kernels as K
 
-SENSE_LATTICE = 0.05  # m; spacing of the points where devices test the reach volumes
-
-
 @dataclass(frozen=True)
 class Layout:
     """Everything the simulator knows about a cell, with the names that go into reports."""
@@ -98,7 +95,6 @@ def build_layout(cell: Cell) -> Layout:
     scal[K.C_VTOL] = spec.criterion.speed_tolerance
     scal[K.C_REACH_ORIGIN] = reach.origin
     scal[K.C_REACH_H] = reach.spacing
-    scal[K.C_SENSE_STEP] = SENSE_LATTICE
 
     params = K.SimParams(
         scal=scal,

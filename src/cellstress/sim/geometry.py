@@ -41,8 +41,8 @@ def segment_segment(p1, q1, p2, q2, c1, c2):
             s = _clamp01(-c / a)
         else:
             b = d1x * d2x + d1y * d2y + d1z * d2z
-            denom = a * e - b * b
-            s = _clamp01((b * f - c * e) / denom) if denom > EPS else 0.0
+            denom = a * e - b * b  # = a e sin^2(angle): parallel test relative to the lengths (scale-free)
+            s = _clamp01((b * f - c * e) / denom) if denom > EPS * a * e else 0.0
             t = (b * s + f) / e
             if t < 0.0:
                 t = 0.0

@@ -38,9 +38,8 @@ NM = 22
 PHASE_RUNNING, PHASE_PENDING, PHASE_BRAKING, PHASE_STOPPED = 0, 1, 2, 3
 
 # scalar parameters (P.scal)
-(C_DT, C_STOP_TIME, C_PHASE0, C_CYCLE, C_DWELL, C_DTOL, C_VTOL, C_REACH_ORIGIN, C_REACH_H,
- C_SENSE_STEP) = range(10)
-N_SCAL = 10
+(C_DT, C_STOP_TIME, C_PHASE0, C_CYCLE, C_DWELL, C_DTOL, C_VTOL, C_REACH_ORIGIN, C_REACH_H) = range(9)
+N_SCAL = 9
 
 # body parameter indices (mirror cellstress.human.body)
 B_HIP_Z, B_SHOULDER_RISE, B_SHOULDER_HALF, B_LEG_HALF, B_HEAD_RISE, B_TRUNK_TOP = range(6)
@@ -493,56 +492,12 @@ def reach_to_segment(P, a, b, r, side, W, n_near, bound, out_q):
 
 # ---- sensing ----------------------------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy", inline="always")
-def _reach_meets_plane_region(P, d, side, W, n_near):
-    """True when the reach volume of arm ``side`` meets device d's detection region (sampled on a lattice)."""
-    L = P.body[B_ARM_LEN]
-    s = W.sh[side]
-    step = P.scal[C_SENSE_STEP]
-    p = W.c1
-    local = W.c2
-    if P.dev_kind[d] == DEV_SCANNER:
-        H = P.dev_rect[d, 4]
-        dz = s[2] - H
-        if abs(dz) >= L:
-            return False
-        rho = np.sqrt(L * L - dz * dz)
-        n = int(rho / step)
-        start, count = P.dev_poly[d, 0], P.dev_poly[d, 1]
-        for i in range(-n, n + 1):
-            for j in range(-n, n + 1):
-                p[0], p[1], p[2] = s[0] + i * step, s[1] + j * step, H
-                if point_in_polygon(p[0], p[1], P.dev_verts, start, count):
-                    if reach_value(P, p, side, W, n_near, local) <= 0.0:
-                        return True
-        return False
-    r = P.dev_rect[d]
-    ux, uy = r[2] - r[0], r[3] - r[1]
-    w = np.sqrt(ux * ux + uy * uy)
-    ux /= w
-    uy /= w
-    dn = (s[0] - r[0]) * -uy + (s[1] - r[1]) * ux
-    if abs(dn) >= L:
-        return False
-    rho = np.sqrt(L * L - dn * dn)
-    us = (s[0] - r[0]) * ux + (s[1] - r[1]) * uy
-    n = int(rho / step)
-    for i in range(-n, n + 1):
-        u = us + i * step
-        if u < 0.0 or u > w:
-            continue
-        for j in range(-n, n + 1):
-            z = s[2] + j * step
-            if z < r[4] or z > r[5]:
-                continue
-            p[0], p[1], p[2] = r[0] + u * ux, r[1] + u * uy, z
-            if reach_value(P, p, side, W, n_near, local) <= 0.0:
-                return True
-    return False
-
-
-@njit(cache=True, error_model="numpy", inline="always")
 def device_sees(P, d, W, n_near):
-    """Does device d detect the worker: a body capsule, or a reach volume, in its detection region?"""
+    """Does device d detect the worker: a body capsule (legs, trunk, head, arms at rest) in its region?
+
+    The reach volumes are not seen: they stand for where an arm *could* strike, and the worst-case worker
+    keeps the arm back until it can. ISO 13855's reach allowance C covers exactly this.
+    """
     if P.dev_kind[d] == DEV_SCANNER:
         H = P.dev_rect[d, 4]
         start, count = P.dev_poly[d, 0], P.dev_poly[d, 1]
@@ -564,23 +519,13 @@ def device_sees(P, d, W, n_near):
                 return True
     else:
         r = P.dev_rect[d]
-        # nothing of the worker (body or reach) is further than this from the hip axis in plan view
-        extent = P.body[B_SHOULDER_HALF] + P.body[B_ARM_LEN] + P.body[B_R_TRUNK] + P.body[B_HEAD_RISE]
+        # no body capsule is further than this from the hip axis in plan view
+        extent = P.body[B_SHOULDER_HALF] + P.body[B_R_TRUNK] + P.body[B_HEAD_RISE]
         if point_segment_2d(W.ha[2, 0], W.ha[2, 1], r[0], r[1], r[2], r[3]) > extent:
             return False
         for c in range(N_BODY_CAPSULES):
             if segment_rectangle(W.ha[c], W.hb[c], r, W.c1, W.c2, W.scratch) <= W.hr[c]:
                 return True
-    L = P.body[B_ARM_LEN]
-    for side in range(2):
-        s = W.sh[side]
-        if P.dev_kind[d] == DEV_SCANNER:
-            gap = abs(s[2] - P.dev_rect[d, 4])
-        else:
-            r = P.dev_rect[d]
-            gap = point_segment_2d(s[0], s[1], r[0], r[1], r[2], r[3])
-        if gap < L and _reach_meets_plane_region(P, d, side, W, n_near):
-            return True
     return False
 
 

@@ -1,0 +1,271 @@
+"""The ``cellstress`` command line: list, check and simulate cells.
+
+User errors (a bad cell file, an unknown action, a bad option) end the program with exit code 2 and one line
+``error: <message>`` on stderr. Heavy modules (pydantic, pinocchio, numba) are imported inside the commands so
+that ``cellstress --help`` starts fast.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Annotated
+
+import typer
+
+from cellstress.errors import CellstressError
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    help="Find hidden human-robot hazards in industrial robot cells.",
+)
+
+USER_ERROR = 2
+CELL_HELP = "A built-in cell name (see 'cellstress cells') or the path of a cell file."
+
+
+def _fail(message: str) -> typer.Exit:
+    """Print ``error: message`` as one line on stderr; the caller raises the returned Exit(2)."""
+    one_line = " ".join(str(message).split())
+    typer.echo(f"error: {one_line}", err=True)
+    return typer.Exit(USER_ERROR)
+
+
+@contextmanager
+def _user_errors(prefix: str = "") -> Iterator[None]:
+    try:
+        yield
+    except CellstressError as exc:
+        raise _fail(prefix + str(exc)) from None
+
+
+def _num(x: float) -> str:
+    """A short, exact-looking number: 1.25, 0.05, 12 (no float noise such as 1.2500000000000002)."""
+    return f"{round(float(x), 6):g}"
+
+
+def _first_sentence(text: str) -> str:
+    text = " ".join(text.split())
+    match = re.search(r"(?<=[.!?])\s", text)
+    return text[: match.start()] if match else text
+
+
+# ---- cells ------------------------------------------------------------------------------------------------
+@app.command()
+def cells() -> None:
+    """List the built-in cells with the first sentence of each description."""
+    import yaml
+
+    from cellstress.cell.load import BUILTIN_CELLS, builtin_text
+
+    width = max(len(n) for n in BUILTIN_CELLS)
+    for name in BUILTIN_CELLS:
+        try:
+            data = yaml.safe_load(builtin_text(name))
+        except CellstressError:
+            typer.echo(f"{name:<{width}}  (missing)")
+            continue
+        except yaml.YAMLError:
+            typer.echo(f"{name:<{width}}  (unreadable YAML: run 'cellstress check {name}')")
+            continue
+        description = data.get("description", "") if isinstance(data, dict) else ""
+        typer.echo(f"{name:<{width}}  {_first_sentence(str(description or '')) or '(no description)'}")
+
+
+# ---- check ------------------------------------------------------------------------------------------------
+def _static_check_lines(cell) -> list[str] | None:
+    """Lines of ``cellstress.cell.iso13855.static_check(cell)``, or None while that module does not exist."""
+    import importlib
+
+    try:
+        iso13855 = importlib.import_module("cellstress.cell.iso13855")
+    except ModuleNotFoundError as exc:
+        if exc.name == "cellstress.cell.iso13855":
+            return None
+        raise  # the module exists but one of its own imports is missing: a real bug, show it
+    result = iso13855.static_check(cell)
+    if result is None:
+        return []
+    if isinstance(result, str):
+        return result.splitlines()
+    if hasattr(result, "lines"):
+        result = result.lines() if callable(result.lines) else result.lines
+    return [str(line) for line in result]
+
+
+@app.command()
+def check(
+    cell: Annotated[str, typer.Argument(help=CELL_HELP)],
+) -> None:
+    """Validate a cell file and print a summary of it."""
+    import numpy as np
+
+    from cellstress.cell.load import BUILTIN_CELLS, load_cell
+    from cellstress.robot.capsules import declared_capsule, fitted_capsules
+    from cellstress.robot.model import load_robot, resolve_urdf
+    from cellstress.robot.trajectory import build_trajectory
+
+    with _user_errors():
+        c = load_cell(cell)
+        spec = c.spec
+        urdf = resolve_urdf(spec.robot.urdf, c.directory)
+        robot = load_robot(urdf)
+        if spec.robot.capsules == "auto":
+            caps = list(fitted_capsules(robot))
+            cap_kind = "fitted to the collision meshes"
+        else:
+            caps = [declared_capsule(robot, k.link, k.link, k.p0, k.p1, k.radius)
+                    for k in spec.robot.capsules]
+            cap_kind = "declared"
+        n_own = len(caps)
+        for i, k in enumerate(spec.robot.extra_capsules):
+            caps.append(declared_capsule(robot, f"{k.link}#extra{i}", k.link, k.p0, k.p1, k.radius))
+        task = spec.robot.task
+        traj = build_trajectory(task.waypoints_deg, task.dwell, task.speed_scale, robot.velocity_limits)
+        static = _static_check_lines(c)
+
+    out = typer.echo
+    origin = "built-in" if cell in BUILTIN_CELLS else "file"
+    out(f"cell        {spec.name}  ({origin}: {c.source}, sha256 {c.sha256[:12]})")
+    if spec.description:
+        out(f"            {_first_sentence(spec.description)}")
+    base = spec.robot.base
+    out(f"robot       {spec.robot.urdf} -> {urdf}")
+    out(f"            {robot.n_joints} joints, base at ({', '.join(_num(v) for v in base.xyz)}) "
+        f"yaw {_num(base.yaw_deg)} deg, stopping time {_num(spec.robot.stopping_time)} s")
+    extra = f" + {len(caps) - n_own} extra" if len(caps) > n_own else ""
+    out(f"capsules    {len(caps)} ({n_own} {cap_kind}{extra})")
+    for k in caps:
+        length = float(np.linalg.norm(np.subtract(k.p1, k.p0)))
+        out(f"            {k.name:<18} on joint {k.joint:>2}  radius {k.radius:.3f} m  length {length:.3f} m")
+    out(f"task        {len(task.waypoints_deg)} waypoints, dwell {_num(task.dwell)} s, speed scale "
+        f"{_num(task.speed_scale)}, phase {_num(task.phase)} s, cycle time {traj.cycle:.2f} s")
+    out(f"table       {len(spec.table.polygons)} polygon(s), height {_num(spec.table.height)} m")
+    panels = sum(len(f.points) - 1 for f in spec.fences)
+    out(f"fences      {len(spec.fences)} ({panels} straight segments)")
+    fl = spec.floor
+    out(f"floor       x {_num(fl.xmin)}..{_num(fl.xmax)} m, y {_num(fl.ymin)}..{_num(fl.ymax)} m")
+    out(f"devices     {len(spec.devices)}")
+    for d in spec.devices:
+        if d.type == "laser-scanner":
+            detail = f"{len(d.polygon)}-point field at {_num(d.height)} m"
+        else:
+            detail = (f"({_num(d.start[0])}, {_num(d.start[1])})-({_num(d.end[0])}, {_num(d.end[1])}), "
+                      f"{_num(d.bottom)}..{_num(d.top)} m, {_num(d.resolution_mm)} mm")
+        out(f"            {d.name:<18} {d.type:<14} response {_num(d.response_time)} s  {detail}")
+    h = spec.human
+    x, y = h.start.xy
+    out(f"human       start ({_num(x)}, {_num(y)}) heading {_num(h.start.heading_deg)} deg, "
+        f"height {_num(h.anthropometry.height)} m, walking {_num(h.walking_speed)} m/s")
+    cr = spec.criterion
+    out(f"criterion   {cr.type} (distance tolerance {_num(cr.distance_tolerance)} m, "
+        f"speed tolerance {_num(cr.speed_tolerance)} m/s)")
+    sim = spec.simulation
+    out(f"simulation  dt {_num(sim.dt)} s, {sim.steps_per_action} steps per action, "
+        f"{sim.actions_per_episode} actions per episode")
+    if static is not None:
+        out("ISO 13855 static check:")
+        for line in static:
+            out(f"  {line}")
+    out("valid")
+
+
+# ---- simulate ---------------------------------------------------------------------------------------------
+def _json_ready(obj):
+    """Replace non-finite floats (which json would write as the invalid NaN/Infinity) by null."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _json_ready(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_json_ready(v) for v in obj]
+    return obj
+
+
+_HEADER = (f"{'step':>4} {'t[s]':>6} {'x[m]':>7} {'y[m]':>7} {'head[deg]':>9} {'fwd[deg]':>8} "
+           f"{'lat[deg]':>8} {'d_HR[m]':>8} {'v_R[m/s]':>8}  {'phase':<12} {'action':<26} devices")
+
+
+def _step_line(r: dict) -> str:
+    devices = ",".join(r["devices"]) or "-"
+    return (f"{r['step']:>4} {r['t']:>6.2f} {r['x']:>7.3f} {r['y']:>7.3f} {r['heading_deg']:>9.1f} "
+            f"{r['forward_flexion_deg']:>8.1f} {r['lateral_flexion_deg']:>8.1f} {r['d_HR']:>8.3f} "
+            f"{r['v_R']:>8.3f}  {r['stop_phase']:<12} {r['action'] or '-':<26} {devices}")
+
+
+@app.command()
+def simulate(
+    cell: Annotated[str, typer.Argument(help=CELL_HELP)],
+    actions: Annotated[str, typer.Option("--actions", "-a", help="Comma-separated actions, e.g. "
+                                         "walk+upright,turn-left-45+bend-forward (WALK+BODY).")],
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON document instead of the table.")] \
+        = False,
+) -> None:
+    """Play a sequence of worker actions in a cell and report whether it ends in an unsafe contact."""
+    from cellstress.human.actions import ACTION_NAMES, parse_actions
+
+    with _user_errors("--actions: "):
+        indices = parse_actions(actions)
+    from cellstress.cell.load import load_cell
+
+    with _user_errors():
+        c = load_cell(cell)
+        from cellstress.sim.simulator import Simulator
+
+        trace = Simulator(c).run(indices)
+    records = trace.records()
+    hit = trace.unsafe_row
+    hazard = None
+    if hit is not None:
+        r = records[hit]
+        hazard = {k: r[k] for k in ("t", "step", "robot_link", "body_part", "robot_point", "human_point",
+                                    "d_HR", "v_R")}
+
+    if as_json:
+        doc = {"cell": c.name, "actions": [ACTION_NAMES[i] for i in indices], "steps": records,
+               "unsafe": hazard is not None, "hazard": hazard}
+        typer.echo(json.dumps(_json_ready(doc), indent=1, allow_nan=False))
+        return
+    typer.echo(_HEADER)
+    for r in records:
+        typer.echo(_step_line(r))
+    if hazard is None:
+        typer.echo("SAFE")
+    else:
+        typer.echo(f"UNSAFE at t={_num(hazard['t'])} s (step {hazard['step']}): "
+                   f"{hazard['robot_link']} / {hazard['body_part']}")
+
+
+# ---- entry point ------------------------------------------------------------------------------------------
+def main(argv: list[str] | None = None) -> int:
+    """The ``cellstress`` console script. Returns the exit code (0 ok, 2 user error)."""
+    command = typer.main.get_command(app)
+    try:
+        rv = command.main(args=argv, prog_name="cellstress", standalone_mode=False)
+    except typer.TyperException as exc:  # click's usage errors and bad parameters
+        message = exc.format_message() if hasattr(exc, "format_message") else str(exc)
+        code = getattr(exc, "exit_code", USER_ERROR)
+        if type(exc).__name__ == "NoArgsIsHelpError":  # bare `cellstress`: the help text, not an error
+            typer.echo(message, err=True)
+            return code
+        ctx = getattr(exc, "ctx", None)
+        hint = f" (see '{ctx.command_path} --help')" if ctx is not None else ""
+        _fail(message.rstrip(".") + "." + hint if message else f"{type(exc).__name__}{hint}")
+        return code
+    except typer.Abort:
+        typer.echo("error: aborted", err=True)
+        return 1
+    except CellstressError as exc:  # normally caught inside the commands already
+        _fail(str(exc))
+        return USER_ERROR
+    return rv if isinstance(rv, int) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,355 @@
+"""The command line: cells, check, simulate (table and JSON), exit codes and start-up cost."""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import types
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from cellstress.cli import app, main
+
+HAZARD_KEYS = {"t", "step", "robot_link", "body_part", "robot_point", "human_point", "d_HR", "v_R"}
+UNSAFE_LINE = re.compile(
+    r"^UNSAFE at t=(?P<t>[0-9.]+) s \(step (?P<step>\d+)\): (?P<link>\S+) / (?P<part>\S+)$"
+)
+
+
+def _run(args: list[str], capsys) -> tuple[int, str, str]:
+    code = main(args)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def _script() -> list[str]:
+    exe = shutil.which("cellstress", path=str(Path(sys.executable).parent))
+    return [exe] if exe else [sys.executable, "-m", "cellstress.cli"]
+
+
+@pytest.fixture(scope="module")
+def baseline() -> dict:
+    text = resources.files("cellstress.cell").joinpath("builtin", "baseline.yaml").read_text(encoding="utf-8")
+    return yaml.safe_load(text)
+
+
+@pytest.fixture(scope="module")
+def unguarded(baseline, tmp_path_factory) -> tuple[Path, list[str]]:
+    """The baseline without safety devices, and an action sequence that ends in an unsafe contact there."""
+    from cellstress.cell.load import load_cell
+    from cellstress.human.actions import ACTION_NAMES
+    from cellstress.sim.simulator import Simulator
+
+    cell = copy.deepcopy(baseline)
+    cell["name"] = "unguarded"
+    cell["devices"] = []
+    path = tmp_path_factory.mktemp("cells") / "unguarded.yaml"
+    path.write_text(yaml.safe_dump(cell, sort_keys=False), encoding="utf-8")
+    sim = Simulator(load_cell(path))
+    n = sim.actions_per_episode
+    candidates = [
+        [b] * n
+        for b in ("walk+upright", "walk+bend-forward", "walk+bend-forward-left", "walk+bend-forward-right")
+    ]
+    for seq in candidates:
+        if sim.run(seq).unsafe:
+            return path, seq
+    acts = np.random.default_rng(0).integers(0, 30, (5000, n))
+    hits = np.flatnonzero(sim.run_batch(acts).unsafe)
+    if not hits.size:
+        pytest.fail("no unsafe sequence found in the baseline without devices; the test needs a new scenario")
+    return path, [ACTION_NAMES[a] for a in acts[hits[0]]]
+
+
+# ---- cells -------------------------------------------------------------------------------------------------
+def test_cells_lists_every_builtin(capsys) -> None:
+    from cellstress.cell.load import BUILTIN_CELLS
+
+    code, out, err = _run(["cells"], capsys)
+    assert code == 0 and err == ""
+    lines = out.strip().splitlines()
+    assert [ln.split()[0] for ln in lines] == list(BUILTIN_CELLS)
+    baseline_line = lines[0]
+    assert len(baseline_line.split()) > 1  # a description follows the name
+
+
+def test_cells_first_sentence_only(capsys, baseline) -> None:
+    code, out, _ = _run(["cells"], capsys)
+    line = next(ln for ln in out.splitlines() if ln.startswith("baseline "))
+    first = " ".join(baseline["description"].split()).split(". ")[0]
+    assert first in line
+    assert line.rstrip().endswith(".")
+    assert line.count(". ") == 0
+
+
+def test_cells_marks_missing_builtin(capsys, monkeypatch) -> None:
+    import cellstress.cell.load as load
+
+    monkeypatch.setattr(load, "BUILTIN_CELLS", (*load.BUILTIN_CELLS, "no-such-builtin"))
+    code, out, _ = _run(["cells"], capsys)
+    assert code == 0
+    assert re.search(r"^no-such-builtin\s+\(missing\)$", out, re.M)
+
+
+# ---- check -------------------------------------------------------------------------------------------------
+def test_check_baseline_summary(capsys, baseline) -> None:
+    code, out, err = _run(["check", "baseline"], capsys)
+    assert code == 0, err
+    assert err == ""
+    assert re.search(r"^cell\s+baseline\b", out, re.M)
+    assert "ur10" in out and "6 joints" in out
+    assert re.search(r"^capsules\s+\d+", out, re.M) and "forearm_link" in out
+    assert re.search(r"cycle time \d+\.\d+ s", out)
+    assert re.search(rf"^table\s+{len(baseline['table']['polygons'])} polygon", out, re.M)
+    assert re.search(rf"^fences\s+{len(baseline['fences'])}\b", out, re.M)
+    assert re.search(rf"^devices\s+{len(baseline['devices'])}\b", out, re.M)
+    for d in baseline["devices"]:
+        assert re.search(rf"{re.escape(d['name'])}\s+{d['type']}\s+response {d['response_time']:g} s", out)
+    x, y = baseline["human"]["start"]["xy"]
+    assert f"start ({x:g}, {y:g}) heading {baseline['human']['start']['heading_deg']:g} deg" in out
+    assert "contact-while-moving" in out
+    assert out.strip().splitlines()[-1] == "valid"
+
+
+def test_check_file_path(capsys, baseline, tmp_path) -> None:
+    cell = copy.deepcopy(baseline)
+    cell["name"] = "my-cell"
+    path = tmp_path / "my.yaml"
+    path.write_text(yaml.safe_dump(cell), encoding="utf-8")
+    code, out, err = _run(["check", str(path)], capsys)
+    assert code == 0, err
+    assert re.search(r"^cell\s+my-cell\b", out, re.M) and str(path) in out
+
+
+@pytest.mark.parametrize(
+    "result", [["field depth ok", "curtain distance ok"], "field depth ok\ncurtain distance ok"]
+)
+def test_check_prints_iso13855_static_check(capsys, monkeypatch, result) -> None:
+    seen = []
+
+    def static_check(cell):
+        seen.append(cell.name)
+        return result
+
+    monkeypatch.setitem(
+        sys.modules, "cellstress.cell.iso13855", types.SimpleNamespace(static_check=static_check)
+    )
+    code, out, err = _run(["check", "baseline"], capsys)
+    assert code == 0, err
+    assert seen == ["baseline"]
+    assert "  field depth ok\n  curtain distance ok\n" in out
+
+
+def test_check_without_iso13855_module(capsys, monkeypatch) -> None:
+    monkeypatch.setitem(sys.modules, "cellstress.cell.iso13855", None)  # import raises ModuleNotFoundError
+    code, out, err = _run(["check", "baseline"], capsys)
+    assert code == 0, err
+    assert "ISO 13855" not in out
+
+
+def test_check_iso13855_user_error_is_one_line(capsys, monkeypatch) -> None:
+    from cellstress.errors import CellError
+
+    def static_check(cell):
+        raise CellError(cell.source, "devices[0]", "too close")
+
+    monkeypatch.setitem(
+        sys.modules, "cellstress.cell.iso13855", types.SimpleNamespace(static_check=static_check)
+    )
+    code, _, err = _run(["check", "baseline"], capsys)
+    assert code == 2 and err == "error: baseline: devices[0]: too close\n"
+
+
+# ---- simulate ----------------------------------------------------------------------------------------------
+def test_simulate_safe_table(capsys) -> None:
+    from cellstress.sim.simulator import Simulator
+
+    actions = ["walk+upright", "turn-left-90+upright", "walk+bend-left"]
+    code, out, err = _run(["simulate", "baseline", "--actions", ",".join(actions)], capsys)
+    assert code == 0, err
+    trace = Simulator("baseline").run(actions)
+    assert not trace.unsafe
+    lines = out.strip().splitlines()
+    assert lines[-1] == "SAFE"
+    header, rows = lines[0], lines[1:-1]
+    for word in ("t[s]", "x[m]", "y[m]", "head", "fwd", "lat", "d_HR", "v_R", "phase", "devices"):
+        assert word in header
+    assert len(rows) == len(trace.rows)  # one line per time step, the initial state included
+    for line, rec in zip(rows, trace.records(), strict=True):
+        fields = line.split()
+        assert int(fields[0]) == rec["step"]
+        assert float(fields[1]) == pytest.approx(rec["t"], abs=0.005)
+        assert float(fields[2]) == pytest.approx(rec["x"], abs=0.0005)
+        assert float(fields[3]) == pytest.approx(rec["y"], abs=0.0005)
+        assert float(fields[7]) == pytest.approx(rec["d_HR"], abs=0.0005)
+        assert rec["stop_phase"] in fields
+
+
+def test_simulate_unsafe_table(capsys, unguarded) -> None:
+    from cellstress.cell.load import load_cell
+    from cellstress.sim.simulator import Simulator
+
+    path, actions = unguarded
+    code, out, err = _run(["simulate", str(path), "--actions", ",".join(actions)], capsys)
+    assert code == 0, err  # unsafe is a finding, not an error
+    trace = Simulator(load_cell(path)).run(actions)
+    hit = trace.record(trace.unsafe_row)
+    last = out.strip().splitlines()[-1]
+    m = UNSAFE_LINE.match(last)
+    assert m, last
+    assert float(m["t"]) == pytest.approx(hit["t"], abs=1e-6)
+    assert int(m["step"]) == hit["step"]
+    assert (m["link"], m["part"]) == (hit["robot_link"], hit["body_part"])
+    assert len(out.strip().splitlines()) == 1 + len(trace.rows) + 1
+
+
+def test_simulate_json_safe(capsys) -> None:
+    actions = ["walk+upright", "walk+bend-forward"]
+    code, out, err = _run(["simulate", "baseline", "--actions", ",".join(actions), "--json"], capsys)
+    assert code == 0, err
+    doc = json.loads(out)
+    assert set(doc) == {"cell", "actions", "steps", "unsafe", "hazard"}
+    assert doc["cell"] == "baseline" and doc["actions"] == actions
+    assert doc["unsafe"] is False and doc["hazard"] is None
+    first = doc["steps"][0]
+    for key in (
+        "t",
+        "x",
+        "y",
+        "heading_deg",
+        "forward_flexion_deg",
+        "lateral_flexion_deg",
+        "d_HR",
+        "v_R",
+        "devices",
+        "stop_phase",
+    ):
+        assert key in first
+    assert [s["step"] for s in doc["steps"]] == list(range(len(doc["steps"])))
+
+
+def test_simulate_json_unsafe(capsys, unguarded) -> None:
+    path, actions = unguarded
+    code, out, err = _run(["simulate", str(path), "-a", ",".join(actions), "--json"], capsys)
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["cell"] == "unguarded" and doc["unsafe"] is True
+    hazard = doc["hazard"]
+    assert set(hazard) == HAZARD_KEYS
+    last = doc["steps"][-1]
+    assert last["unsafe"] is True
+    for key in HAZARD_KEYS:
+        assert hazard[key] == last[key]
+    assert len(hazard["robot_point"]) == 3 and len(hazard["human_point"]) == 3
+
+
+def test_simulate_json_is_strict_json(capsys) -> None:
+    code, out, _ = _run(["simulate", "baseline", "--actions", "walk+upright", "--json"], capsys)
+    assert code == 0
+    assert "NaN" not in out and "Infinity" not in out
+    json.loads(out, parse_constant=lambda c: pytest.fail(f"non-standard JSON constant {c}"))
+
+
+def test_simulate_accepts_spaces_and_case(capsys) -> None:
+    code, out, err = _run(
+        ["simulate", "baseline", "--actions", " Walk+Upright , walk+bend-left ", "--json"], capsys
+    )
+    assert code == 0, err
+    assert json.loads(out)["actions"] == ["walk+upright", "walk+bend-left"]
+
+
+# ---- exit codes and error lines ----------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "args,words",
+    [
+        (["simulate", "baseline"], ["Missing option", "--actions"]),
+        (["check"], ["Missing argument"]),
+        (["frobnicate"], ["No such command"]),
+        (["simulate", "baseline", "--actions", "walk+upright", "--fast"], ["No such option", "--fast"]),
+        (["check", "baseline", "extra"], ["unexpected extra argument"]),
+    ],
+)
+def test_usage_errors_exit_2_with_one_line(capsys, args, words) -> None:
+    code, out, err = _run(args, capsys)
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ")
+    for w in words:
+        assert w.lower() in lines[0].lower()
+
+
+def test_help_exits_0(capsys) -> None:
+    code, out, _ = _run(["--help"], capsys)
+    assert code == 0
+    assert "simulate" in out and "check" in out and "cells" in out
+
+
+def test_cli_runner_user_error_is_one_line() -> None:
+    """Through typer's own runner (no main()): a CellstressError still gives exit 2 and one stderr line."""
+    result = CliRunner().invoke(app, ["check", "/no/such/cell.yaml"])
+    assert result.exit_code == 2
+    assert result.stderr.strip() == (
+        "error: /no/such/cell.yaml: no such file, and not a built-in cell "
+        "(baseline, s1-scanner-width, s2-elbow-intrusion, s3-fence-gap)"
+    )
+    assert result.stdout == ""
+
+
+def test_console_script_end_to_end(tmp_path) -> None:
+    env = {**os.environ, "NO_COLOR": "1"}
+    ok = subprocess.run(
+        [*_script(), "simulate", "baseline", "--actions", "walk+upright"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env=env,
+    )
+    assert ok.returncode == 0, ok.stderr
+    assert ok.stdout.strip().splitlines()[-1] == "SAFE"
+    usage = subprocess.run(
+        [*_script(), "simulate", "baseline"], capture_output=True, text=True, timeout=120, env=env
+    )
+    assert usage.returncode == 2
+    assert len(usage.stderr.strip().splitlines()) == 1 and "Traceback" not in usage.stderr
+    bad = subprocess.run(
+        [*_script(), "simulate", "baseline", "--actions", "jump+upright"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+    )
+    assert bad.returncode == 2
+    assert bad.stderr.startswith("error: --actions: unknown action 'jump+upright'")
+
+
+def test_import_is_light() -> None:
+    """`cellstress --help` must not pay for numba, pinocchio or the simulator."""
+    code = (
+        "import sys, cellstress.cli; heavy = [m for m in ('numba', 'pinocchio', 'cellstress.sim.simulator', "
+        "'pydantic') if m in sys.modules]; print(','.join(heavy))"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == ""
+
+
+def test_check_declared_capsules(capsys, baseline, tmp_path) -> None:
+    cell = copy.deepcopy(baseline)
+    cell["robot"]["capsules"] = [{"link": "forearm_link", "p0": [0, 0, 0], "p1": [0, 0, 0.5], "radius": 0.08}]
+    cell["robot"]["extra_capsules"] = []
+    path = tmp_path / "declared.yaml"
+    path.write_text(yaml.safe_dump(cell), encoding="utf-8")
+    code, out, err = _run(["check", str(path)], capsys)
+    assert code == 0, err
+    assert re.search(r"^capsules\s+1 \(1 declared\)", out, re.M)
+    assert re.search(r"forearm_link\s+on joint\s+\d+\s+radius 0\.080 m\s+length 0\.500 m", out)
