@@ -19,11 +19,11 @@ from scipy.optimize import minimize
 from scipy.spatial import cKDTree
 
 from cellstress.human.reach import JOINT_RANGES_DEG, arm_points, reach_field
-from cellstress.sim.kernels import reach_lookup
 
 LENGTHS = (0.30, 0.31, 0.18)  # upper arm, forearm, hand [m]
 ARM = float(sum(LENGTHS))
 LO, HI = np.deg2rad(JOINT_RANGES_DEG).T
+BOUNDS = list(zip(LO, HI, strict=True))
 
 
 @pytest.fixture(scope="module")
@@ -76,7 +76,7 @@ def chain_points(chain, n):
 
 
 def trilinear(field, pts):
-    """numpy trilinear lookup with the same outside-the-grid rule as the kernel (distance to the grid added)."""
+    """numpy trilinear lookup, with the kernel's rule outside the grid (the distance to the grid added)."""
     v, h, o = field.values.astype(float), field.spacing, field.origin
     n = v.shape[0]
     top = o + (n - 1) * h
@@ -89,7 +89,8 @@ def trilinear(field, pts):
     for dx in (0, 1):
         for dy in (0, 1):
             for dz in (0, 1):
-                w = (f[:, 0] if dx else 1 - f[:, 0]) * (f[:, 1] if dy else 1 - f[:, 1]) * (f[:, 2] if dz else 1 - f[:, 2])
+                w = ((f[:, 0] if dx else 1 - f[:, 0]) * (f[:, 1] if dy else 1 - f[:, 1])
+                     * (f[:, 2] if dz else 1 - f[:, 2]))
                 out += w * v[i[:, 0] + dx, i[:, 1] + dy, i[:, 2] + dz]
     return out + extra
 
@@ -175,14 +176,14 @@ def test_every_arm_point_is_inside_or_within_a_voxel(field):
     bound = h * np.sqrt(3)
     rng = np.random.default_rng(2024)
     qs = np.concatenate([random_configs(rng, 20_000), random_configs(rng, 20_000, at_limit=0.5)])
-    d = np.concatenate([trilinear(field, chain_points(arm_chain(chunk), 20).reshape(-1, 3)).reshape(len(chunk), -1)
-                        .max(axis=1) for chunk in np.array_split(qs, 4)])
+    d = np.concatenate([trilinear(field, chain_points(arm_chain(chunk), 20).reshape(-1, 3))
+                        .reshape(len(chunk), -1).max(axis=1) for chunk in np.array_split(qs, 4)])
     k = int(np.argmax(d))
-    assert d[k] <= bound, f"{np.sum(d > bound)} configurations reach beyond the field; worst {d[k] / h:.2f} h " \
-                          f"at q = {np.round(np.rad2deg(qs[k]), 1)} deg"
+    assert d[k] <= bound, (f"{np.sum(d > bound)} configurations reach beyond the field; worst "
+                           f"{d[k] / h:.2f} h at q = {np.round(np.rad2deg(qs[k]), 1)} deg")
     worst, worst_q = d[k], qs[k]
     for start in qs[np.argsort(-d)[:12]]:
-        res = minimize(lambda q: -_arm_field_max(q, field), start, method="Nelder-Mead", bounds=list(zip(LO, HI)),
+        res = minimize(lambda q: -_arm_field_max(q, field), start, method="Nelder-Mead", bounds=BOUNDS,
                        options={"maxfev": 250, "xatol": 1e-4, "fatol": 1e-6})
         if -res.fun > worst:
             worst, worst_q = -res.fun, res.x
@@ -228,7 +229,8 @@ def test_clearly_inside_points_are_reachable(field):
     vals = field.values.ravel()
     deep = np.flatnonzero(vals < -2 * h)
     rim = np.flatnonzero((vals < -2 * h) & (vals > -3.5 * h))  # just inside the threshold: the hardest
-    targets = grid[np.concatenate([rng.choice(deep, 150, replace=False), rng.choice(rim, 150, replace=False)])]
+    picks = np.concatenate([rng.choice(deep, 150, replace=False), rng.choice(rim, 150, replace=False)])
+    targets = grid[picks]
 
     pool_q = random_configs(rng, 60_000, at_limit=0.3)
     pool_pts = chain_points(arm_chain(pool_q), 10)
@@ -244,11 +246,11 @@ def test_clearly_inside_points_are_reachable(field):
         best = drow[0]
         starts = list(dict.fromkeys(irow // per))[:6]  # distinct configurations, nearest first
         for s in starts:
-            res = minimize(_polyline_distance, pool_q[s], args=(x,), method="L-BFGS-B", bounds=list(zip(LO, HI)))
+            res = minimize(_polyline_distance, pool_q[s], args=(x,), method="L-BFGS-B", bounds=BOUNDS)
             best = min(best, res.fun)
             if best <= 2 * h:
                 break
         if best > 2 * h:
             unreached.append((x, best, trilinear(field, x[None])[0]))
-    assert not unreached, f"{len(unreached)} of {len(targets)} inside points not reached, e.g. {unreached[:3]}"
+    assert not unreached, f"{len(unreached)} of {len(targets)} inside points not reached: {unreached[:3]}"
     assert optimised < len(targets)  # the pool alone settles most; the optimiser handles the rest

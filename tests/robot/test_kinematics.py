@@ -180,8 +180,8 @@ def test_trajectory_visits_the_waypoints(setup):
 
 
 def test_trajectory_velocity_is_continuous(setup):
-    """Sampled every dt, no joint velocity jumps by more than max|acceleration| * dt (anywhere, joins included);
-    a minimum-jerk move of dq in T has max|acceleration| = (10 / sqrt(3)) |dq| / T^2."""
+    """Sampled every dt, no joint velocity jumps by more than max|acceleration| * dt (anywhere, joins
+    included); a minimum-jerk move of dq in T has max|acceleration| = (10 / sqrt(3)) |dq| / T^2."""
     sim, P, _, _ = setup
     traj = sim.layout.trajectory
     dt = 1e-4
@@ -214,7 +214,8 @@ def test_peak_joint_speed_respects_scaled_limits(setup):
     vmax = sim.layout.robot.velocity_limits
     limit = scale * vmax
     q, qd = np.zeros(6), np.zeros(6)
-    taus = np.concatenate([np.linspace(0.0, traj.cycle, 20001), traj.starts + traj.dwell + 0.5 * traj.move_times])
+    mid = traj.starts + traj.dwell + 0.5 * traj.move_times  # where each move peaks
+    taus = np.concatenate([np.linspace(0.0, traj.cycle, 20001), mid])
     peak = np.zeros(6)
     for tau in taus:
         K.joint_trajectory(P, tau, 1.0, q, qd)

@@ -549,13 +549,17 @@ def feet_ok(P, x, y):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def trunk_clear(P, W):
-    """Trunk and head do not pass through any fence panel (the hands' reach is limited separately)."""
-    extent = P.body[B_HEAD_RISE] + P.body[B_R_HEAD]
+    """Trunk, head and arms (from the shoulders down) do not pass through any fence panel.
+
+    The shoulders matter most: the reach volumes hang on them, so a shoulder past a panel would reach
+    around it for free. (Where the hands can get past a panel is limited separately, by fence_detour.)
+    """
+    extent = P.body[B_HEAD_RISE] + P.body[B_R_HEAD] + P.body[B_SHOULDER_HALF]
     for f in range(P.fences.shape[0]):
         fe = P.fences[f]
         if point_segment_2d(W.ha[2, 0], W.ha[2, 1], fe[0], fe[1], fe[2], fe[3]) > extent:
             continue
-        for c in (2, 3):
+        for c in (2, 3, 4, 5):
             if segment_rectangle(W.ha[c], W.hb[c], P.fences[f], W.c1, W.c2, W.scratch) < W.hr[c]:
                 return False
     return True
