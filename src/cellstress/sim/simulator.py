@@ -88,19 +88,34 @@ class BatchResult:
 class Simulator:
     """The cell's physics. ``Simulator("s1-scanner-width")`` or ``Simulator(load_cell(path))``."""
 
-    def __init__(self, cell: Cell | str | Path):
-        if not isinstance(cell, Cell):
-            cell = load_cell(cell)
-        self.layout = build_layout(cell)
+    def __init__(self, cell: Cell | str | Path | Layout, start: tuple[float, float, float] | None = None):
+        """``start`` = (x, y, heading_deg) replaces the cell's start pose (e.g. to test other entry points).
+
+        ``cell`` may also be the ``layout`` of another Simulator, to share its (costly) set-up.
+        """
+        if isinstance(cell, Layout):
+            self.layout = cell
+            cell = cell.cell
+        else:
+            if not isinstance(cell, Cell):
+                cell = load_cell(cell)
+            self.layout = build_layout(cell)
         self.params = self.layout.params
         self._work = K.make_work(self.params)
-        start = cell.spec.human.start
+        if start is None:
+            s = cell.spec.human.start
+            start = (s.xy[0], s.xy[1], s.heading_deg)
+        self.start = tuple(float(v) for v in start)
         self._s0 = np.zeros(K.NS)
         self._row0 = np.zeros(K.NM)
-        K.reset_state(self.params, float(start.xy[0]), float(start.xy[1]), float(np.deg2rad(start.heading_deg)),
+        K.reset_state(self.params, self.start[0], self.start[1], float(np.deg2rad(self.start[2])),
                       self._s0, self._work, self._row0)
         self._s0.setflags(write=False)
         self._rows = np.zeros((self.params.spa, K.NM))
+
+    def with_start(self, start: tuple[float, float, float]) -> Simulator:
+        """The same cell with another start pose (x, y, heading_deg); shares this simulator's set-up."""
+        return Simulator(self.layout, start=start)
 
     # ---- facts ------------------------------------------------------------------------------------------
     @property
