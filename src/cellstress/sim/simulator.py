@@ -52,7 +52,7 @@ def step_record(row: np.ndarray, layout: Layout) -> dict:
     act = int(row[K.M_ACTION])
     return {
         "step": int(row[K.M_STEP]),
-        "t": float(row[K.M_T]),
+        "t": round(float(row[K.M_T]), 9),  # k * dt carries float noise (0.6000000000000001)
         "action": ACTION_NAMES[act] if act >= 0 else None,
         "x": float(row[K.M_X]),
         "y": float(row[K.M_Y]),

@@ -1,0 +1,3 @@
+from cellstress.cli import main
+
+main()
