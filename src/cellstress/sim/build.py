@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cellstress.cell.load import Cell
+from cellstress.devices import device_arrays, pack_polygons
 from cellstress.human.actions import action_table
 from cellstress.human.body import BodyDimensions
 from cellstress.human.reach import ReachField, reach_field
@@ -37,14 +38,6 @@ def _base_matrix(xyz, yaw_deg) -> np.ndarray:
     return m
 
 
-def _polygons(polys) -> tuple[np.ndarray, np.ndarray]:
-    verts, index = [], []
-    for p in polys:
-        index.append((len(verts), len(p)))
-        verts.extend(p)
-    return np.asarray(verts, dtype=float).reshape(-1, 2), np.asarray(index, dtype=np.int64).reshape(-1, 2)
-
-
 def build_layout(cell: Cell) -> Layout:
     spec = cell.spec
     robot = load_robot(resolve_urdf(spec.robot.urdf, cell.directory))
@@ -70,20 +63,9 @@ def build_layout(cell: Cell) -> Layout:
 
     fences = [(a[0], a[1], b[0], b[1], f.bottom, f.top)
               for f in spec.fences for a, b in zip(f.points, f.points[1:], strict=False)]
-    table_verts, table_poly = _polygons(spec.table.polygons)
+    table_verts, table_poly = pack_polygons(spec.table.polygons)
 
-    kinds, resp, rects, dev_polys = [], [], [], []
-    for d in spec.devices:
-        resp.append(d.response_time)
-        if d.type == "laser-scanner":
-            kinds.append(K.DEV_SCANNER)
-            rects.append((0.0, 0.0, 0.0, 0.0, d.height, d.height))
-            dev_polys.append(d.polygon)
-        else:
-            kinds.append(K.DEV_CURTAIN)
-            rects.append((*d.start, *d.end, d.bottom, d.top))
-            dev_polys.append(())
-    dev_verts, dev_poly = _polygons([p for p in dev_polys])
+    dev = device_arrays(spec.devices)
 
     scal = np.zeros(K.N_SCAL)
     scal[K.C_DT] = spec.simulation.dt
@@ -118,11 +100,11 @@ def build_layout(cell: Cell) -> Layout:
         table_verts=table_verts,
         table_poly=table_poly,
         floor=np.asarray([spec.floor.xmin, spec.floor.xmax, spec.floor.ymin, spec.floor.ymax], dtype=float),
-        dev_kind=np.asarray(kinds, dtype=np.int64),
-        dev_resp=np.asarray(resp, dtype=float),
-        dev_rect=np.asarray(rects, dtype=float).reshape(-1, 6),
-        dev_poly=dev_poly,
-        dev_verts=dev_verts,
+        dev_kind=dev.kind,
+        dev_resp=dev.response,
+        dev_rect=dev.rect,
+        dev_poly=dev.poly,
+        dev_verts=dev.verts,
         pre_ra=np.zeros((0, len(caps), 3)),
         pre_rb=np.zeros((0, len(caps), 3)),
         pre_v=np.zeros(0),
@@ -134,4 +116,4 @@ def build_layout(cell: Cell) -> Layout:
     pre_v, pre_tau = np.zeros(n_pre), np.zeros(n_pre)
     K.robot_table(params, n_pre, pre_ra, pre_rb, pre_v, pre_tau)
     params = params._replace(pre_ra=pre_ra, pre_rb=pre_rb, pre_v=pre_v, pre_tau=pre_tau)
-    return Layout(cell, robot, tuple(caps), traj, body, reach, tuple(d.name for d in spec.devices), params)
+    return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params)
