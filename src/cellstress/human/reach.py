@@ -109,7 +109,7 @@ def _rasterise(grid, origin, h, lengths, qs):
 
 def _joint_samples(step_deg: tuple[float, float, float, float, float]) -> np.ndarray:
     axes = [np.deg2rad(np.arange(lo, hi + 1e-9, s)) for (lo, hi), s in zip(JOINT_RANGES_DEG, step_deg, strict=True)]
-    for ax, (lo, hi) in zip(axes, np.deg2rad(JOINT_RANGES_DEG), strict=True):
+    for ax, (_lo, hi) in zip(axes, np.deg2rad(JOINT_RANGES_DEG), strict=True):
         ax[-1] = hi  # always include the range ends
     mesh = np.meshgrid(*axes, indexing="ij")
     return np.stack([m.ravel() for m in mesh], axis=1)
