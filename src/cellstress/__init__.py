@@ -6,10 +6,11 @@ from typing import TYPE_CHECKING
 
 __version__ = "0.1.0"
 
-__all__ = ["BUILTIN_CELLS", "Cell", "Simulator", "__version__", "load_cell"]
+__all__ = ["BUILTIN_CELLS", "Cell", "Simulator", "__version__", "load_cell", "search"]
 
 if TYPE_CHECKING:
     from cellstress.cell.load import BUILTIN_CELLS, Cell, load_cell
+    from cellstress.search import search
     from cellstress.sim.simulator import Simulator
 
 
@@ -23,4 +24,9 @@ def __getattr__(name: str):
         from cellstress.sim.simulator import Simulator
 
         return Simulator
+    if name == "search":
+        # the subpackage cellstress.search is callable: cellstress.search(cell, searcher=..., budget=..., seed=...)
+        import importlib
+
+        return importlib.import_module("cellstress.search")
     raise AttributeError(f"module 'cellstress' has no attribute {name!r}")

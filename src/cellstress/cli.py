@@ -1,4 +1,4 @@
-"""The ``cellstress`` command line: list, check and simulate cells.
+"""The ``cellstress`` command line: list, check and simulate cells; search for hazards and replay them.
 
 User errors (a bad cell file, an unknown action, a bad option) end the program with exit code 2 and one line
 ``error: <message>`` on stderr. Heavy modules (pydantic, pinocchio, numba) are imported inside the commands so
@@ -240,6 +240,169 @@ def simulate(
     else:
         typer.echo(f"UNSAFE at t={_num(hazard['t'])} s (step {hazard['step']}): "
                    f"{hazard['robot_link']} / {hazard['body_part']}")
+
+
+# ---- search -----------------------------------------------------------------------------------------------
+def _check_out_dir(out: str):
+    """The --out folder, created if needed; exit 2 when it cannot be written."""
+    import os
+    import tempfile
+    from pathlib import Path
+
+    path = Path(out).expanduser()
+    try:
+        if path.exists() and not path.is_dir():
+            raise _fail(f"--out {out}: exists and is not a directory")
+        path.mkdir(parents=True, exist_ok=True)
+        fd, probe = tempfile.mkstemp(prefix=".write-test-", dir=path)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise _fail(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
+    return path
+
+
+def _params_text(params: dict) -> str:
+    return ", ".join(f"{k} {'auto' if v is None else _num(v) if isinstance(v, float) else v}"
+                     for k, v in params.items())
+
+
+@app.command()
+def search(
+    cell: Annotated[str, typer.Argument(help=CELL_HELP)],
+    out: Annotated[str, typer.Option("--out", "-o", help="Folder for result.json (created if needed).")],
+    searcher: Annotated[str, typer.Option("--searcher", "-s", help="random, mcts (MCTS1: from s0 for the "
+                                          "whole budget) or mcts-commit (MCTS2: commit and re-root).")] = "mcts",
+    budget: Annotated[int, typer.Option("--budget", "-b", help="Episodes (one iteration = one episode of "
+                                        "up to 8 actions from s0).")] = 200,
+    seed: Annotated[int, typer.Option("--seed", help="Seed (>= 0) of numpy's SeedSequence.")] = 0,
+    until: Annotated[str, typer.Option("--until", help="first: stop at the first unsafe state; budget: play "
+                                       "the whole budget and record every hazardous episode.")] = "first",
+    top_k: Annotated[int, typer.Option("--top-k", help="How many of the best episodes to keep.")] = 10,
+    ec: Annotated[float | None, typer.Option("--ec", help="MCTS exploration constant (default 0.5; "
+                                        "returns here differ by about 1 between good and bad prefixes).")] = None,
+    k: Annotated[float | None, typer.Option("--k", help="MCTS widening factor k: a node tries a "
+                                      "new action while children <= k N^alpha (default 1.0).")] = None,
+    alpha: Annotated[float | None, typer.Option("--alpha", help="MCTS widening exponent (default 0.85).")] \
+        = None,
+    n: Annotated[int | None, typer.Option("--n", help="mcts-commit: iterations per decision "
+                                          "(default budget // 8).")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print result.json to stdout instead of the "
+                                          "summary.")] = False,
+) -> None:
+    """Search a cell for a sequence of worker actions that ends in an unsafe contact; write result.json."""
+    import time
+
+    from cellstress.search import make_searcher
+    from cellstress.search import search as run
+    from cellstress.search.common import check_common
+
+    options = {name: v for name, v in (("ec", ec), ("k", k), ("alpha", alpha), ("n", n)) if v is not None}
+    with _user_errors():
+        check_common(budget, seed, until, top_k)
+        make_searcher(searcher, **options)
+    out_dir = _check_out_dir(out)
+    from cellstress.cell.load import load_cell
+
+    with _user_errors():
+        c = load_cell(cell)
+        from cellstress.sim.simulator import Simulator
+
+        sim = Simulator(c)
+
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    console = Console(stderr=True)
+    progress = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+                        TextColumn("{task.fields[rate]:>7.0f} episodes/s  best risk {task.fields[risk]:.3f}"),
+                        TimeElapsedColumn(), console=console, transient=True,
+                        disable=not console.is_terminal)
+    task = progress.add_task(searcher, total=budget, rate=0.0, risk=0.0)
+    t0 = time.perf_counter()
+
+    def tick(done: int, best_risk: float) -> None:
+        if done % 8 == 0 or done == budget:
+            progress.update(task, completed=done, rate=done / max(time.perf_counter() - t0, 1e-9), risk=best_risk)
+
+    with progress, _user_errors():
+        result = run(sim, searcher, budget, seed, until=until, top_k=top_k, progress=tick, **options)
+    elapsed = time.perf_counter() - t0
+    try:
+        path = result.write(out_dir)
+    except OSError as exc:
+        raise _fail(f"--out {out}: cannot write result.json ({exc.strerror or exc})") from None
+    rate = result.episodes / max(elapsed, 1e-9)
+    if as_json:
+        typer.echo(result.to_json(), nl=False)
+        typer.echo(f"{result.episodes} episodes in {elapsed:.2f} s ({rate:.0f} episodes/s); wrote {path}",
+                   err=True)
+        return
+    echo = typer.echo
+    echo(f"cell      {result.cell['name']}  searcher {result.searcher} ({_params_text(result.params)})  "
+         f"seed {seed}  budget {budget}")
+    best = max(result.risk_per_episode, default=0.0)
+    h = result.hazard
+    if h is None:
+        echo(f"no hazard in {result.episodes} episodes (best risk 1/c_S {best:.3f}; {elapsed:.2f} s, "
+             f"{rate:.0f} episodes/s)")
+    else:
+        extra = f", {len(result.hazards)} hazardous episodes in all" if until == "budget" else ""
+        echo(f"FOUND at episode {h['episode']} of {budget}{extra} ({result.episodes} episodes in "
+             f"{elapsed:.2f} s, {rate:.0f} episodes/s)")
+        echo(f"actions   {', '.join(h['actions'])}")
+        x, y, z = h["point"]
+        echo(f"contact   t={_num(h['time_s'])} s (step {h['step']}): {h['robot_link']} / {h['body_part']} at "
+             f"({x:.3f}, {y:.3f}, {z:.3f}) m, robot moving at v_R {h['v_R']:.3f} m/s")
+    echo(f"wrote     {path}")
+
+
+# ---- replay -----------------------------------------------------------------------------------------------
+@app.command()
+def replay(
+    result_file: Annotated[str, typer.Argument(help="A result.json written by 'cellstress search' (or its "
+                                               "folder).")],
+) -> None:
+    """Re-simulate the hazard of a search result and check it bit-exactly against the recorded trace.
+
+    Exit code 0 if the replay agrees with the file, 1 if it does not."""
+    from cellstress.search.result import SearchResult, json_ready
+
+    with _user_errors():
+        res = SearchResult.load(result_file)
+    h = res.hazard
+    if h is None:
+        raise _fail(f"{result_file}: the search found no hazard; there is nothing to replay")
+    from cellstress.cell.load import load_cell
+
+    with _user_errors():
+        c = load_cell(res.cell.get("source", res.cell["name"]))
+        from cellstress.sim.simulator import Simulator
+
+        trace = Simulator(c).run(h["actions"])
+    records = json_ready(trace.records())
+    for r in records:
+        typer.echo(_step_line(r)) if r is not records[0] else (typer.echo(_HEADER), typer.echo(_step_line(r)))
+    problems = []
+    if c.sha256 != res.cell["sha256"]:
+        problems.append(f"the cell differs from the one searched (sha256 {c.sha256[:12]} != "
+                        f"{str(res.cell['sha256'])[:12]})")
+    recorded = h["trace"]
+    if len(records) != len(recorded):
+        problems.append(f"the replay has {len(records)} rows, the file {len(recorded)}")
+    for i, (a, b) in enumerate(zip(records, recorded, strict=False)):
+        if json.dumps(a, sort_keys=True) != json.dumps(b, sort_keys=True):
+            keys = sorted(k for k in set(a) | set(b) if json.dumps(a.get(k)) != json.dumps(b.get(k)))
+            problems.append(f"row {i} differs in {', '.join(keys)}")
+            break
+    if not trace.unsafe:
+        problems.append("the replayed episode does not reach an unsafe state")
+    if problems:
+        for p in problems:
+            typer.echo(f"MISMATCH: {p}")
+        raise typer.Exit(1)
+    typer.echo(f"REPRODUCED bit-exactly: UNSAFE at t={_num(h['time_s'])} s (step {h['step']}): "
+               f"{h['robot_link']} / {h['body_part']}, v_R {h['v_R']:.3f} m/s")
 
 
 # ---- entry point ------------------------------------------------------------------------------------------

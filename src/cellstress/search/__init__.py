@@ -1,0 +1,134 @@
+"""Search for hazards: ``random``, ``mcts`` (the paper's MCTS1) and ``mcts-commit`` (MCTS2).
+
+One module per searcher over shared machinery (``common``: problem interface, reward, budget, top-k;
+``tree``: the DPW tree; ``result``: the result record). ``search`` is the public entry point.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import asdict, fields
+from pathlib import Path
+
+from cellstress.search.common import (
+    UNTIL,
+    Episode,
+    Outcome,
+    Problem,
+    Recorder,
+    Reward,
+    SearchError,
+    SimProblem,
+    Stop,
+    check_common,
+)
+from cellstress.search.mcts import MCTS
+from cellstress.search.mcts_commit import MCTSCommit
+from cellstress.search.random_search import RandomSearch
+from cellstress.search.result import SearchResult
+
+SEARCHERS = {"random": RandomSearch, "mcts": MCTS, "mcts-commit": MCTSCommit}
+DEFAULT_BUDGET = 200
+DEFAULT_TOP_K = 10
+
+__all__ = ["SEARCHERS", "UNTIL", "Episode", "MCTS", "MCTSCommit", "Outcome", "Problem", "RandomSearch",
+           "Recorder", "Reward", "SearchError", "SearchResult", "SimProblem", "make_searcher", "run_search",
+           "search"]
+
+
+def make_searcher(name: str, **options):
+    """The searcher ``name`` with ``options``; SearchError for an unknown name or option."""
+    cls = SEARCHERS.get(name)
+    if cls is None:
+        raise SearchError(f"unknown searcher {name!r} (choose from {', '.join(SEARCHERS)})")
+    known = {f.name for f in fields(cls)}
+    bad = sorted(set(options) - known)
+    if bad:
+        raise SearchError(f"searcher {name!r} has no option {', '.join(bad)} (options: {', '.join(sorted(known))})")
+    return cls(**options)
+
+
+def run_search(problem, reward, searcher="mcts", budget=DEFAULT_BUDGET, seed=0, *, until="first",
+               top_k=DEFAULT_TOP_K, progress=None, **options) -> Outcome:
+    """Search any ``Problem`` (e.g. a toy) with a reward ``reward(d, v, last_action, unsafe) -> (r, risk)``."""
+    check_common(budget, seed, until, top_k)
+    s = searcher if not isinstance(searcher, str) else make_searcher(searcher, **options)
+    rec = Recorder(int(budget), until, int(top_k), progress)
+    try:
+        s.run(problem, reward, rec, int(seed))
+    except Stop:
+        pass
+    return Outcome(rec.episodes, tuple(rec.hazards), tuple(rec.top.best()), tuple(rec.risks))
+
+
+def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int = 0, *, until: str = "first",
+           top_k: int = DEFAULT_TOP_K, progress=None, **options) -> SearchResult:
+    """Search a cell (built-in name, path, ``Cell`` or ``Simulator``) for an unsafe action sequence.
+
+    ``searcher`` is ``random``, ``mcts`` or ``mcts-commit``; ``options`` are its parameters (see
+    ``MCTS``, ``MCTSCommit``, ``RandomSearch``). ``until="first"`` stops at the first hazard,
+    ``until="budget"`` plays the whole budget. ``progress(episodes, best_risk)`` is called after each episode.
+    """
+    from cellstress import __version__
+    from cellstress.criteria import criterion_for
+    from cellstress.human.actions import ACTION_NAMES
+    from cellstress.sim.simulator import Simulator
+
+    check_common(budget, seed, until, top_k)
+    s = make_searcher(searcher, **options)
+    sim = cell if isinstance(cell, Simulator) else Simulator(cell)
+    c = sim.cell
+    reward = Reward(criterion_for(c.spec.criterion))
+    out = run_search(SimProblem(sim), reward, s, budget, seed, until=until, top_k=top_k, progress=progress)
+
+    def names(actions):
+        return [ACTION_NAMES[a] for a in actions]
+
+    hazard = None
+    first = out.first_hazard
+    if first is not None:
+        trace = sim.run(list(first.actions))
+        records = trace.records()
+        hit = records[trace.unsafe_row]
+        hazard = {
+            "episode": first.index,
+            "actions": names(first.actions),
+            "step": hit["step"],
+            "time_s": hit["t"],
+            "robot_link": hit["robot_link"],
+            "body_part": hit["body_part"],
+            "point": hit["robot_point"],
+            "human_point": hit["human_point"],
+            "v_R": hit["v_R"],
+            "d_HR": hit["d_HR"],
+            "trace": records,
+        }
+    return SearchResult(
+        # a cell file by its absolute path, so that `cellstress replay` works from any folder
+        cell={"name": c.name, "sha256": c.sha256,
+              "source": c.source if c.directory is None else str(Path(c.source).expanduser().resolve())},
+        searcher=s.name,
+        params=asdict(s),
+        seed=int(seed),
+        budget=int(budget),
+        until=until,
+        found=out.found,
+        episodes=out.episodes,
+        hazard=hazard,
+        hazards=[{"episode": h.index, "actions": names(h.actions)} for h in out.hazards],
+        top=[{"episode": e.index, "actions": names(e.actions), "return": e.ret, "risk": e.risk,
+              "unsafe": e.unsafe} for e in out.top],
+        risk_per_episode=list(out.risks),
+        version=__version__,
+    )
+
+
+class _CallableModule(type(sys.modules[__name__])):
+    """``cellstress.search`` is this package *and* the function: ``cellstress.search(cell, ...)`` works
+    whichever of the two an import left on the ``cellstress`` module."""
+
+    def __call__(self, *args, **kwargs) -> SearchResult:
+        return search(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

@@ -1,0 +1,107 @@
+"""The result record of a search and its JSON file.
+
+``result.json`` holds no wall-clock fields: the same inputs give a byte-identical file (keys sorted, floats
+written with Python's shortest round-trip repr, non-finite floats as null, written atomically through a
+temporary file and ``os.replace``). Timing goes to the console only.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from cellstress.search.common import SearchError
+
+FORMAT = 1
+FILE_NAME = "result.json"
+
+
+def json_ready(obj):
+    """Plain JSON values: non-finite floats -> null, tuples -> lists, numpy scalars -> Python numbers."""
+    if isinstance(obj, bool) or obj is None or isinstance(obj, str):
+        return obj
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, int):
+        return int(obj)
+    if isinstance(obj, dict):
+        return {str(k): json_ready(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_ready(v) for v in obj]
+    if hasattr(obj, "item"):  # numpy scalar
+        return json_ready(obj.item())
+    raise TypeError(f"not JSON-ready: {type(obj).__name__}")
+
+
+@dataclass(frozen=True)
+class SearchResult:
+    """What ``cellstress.search`` returns and ``result.json`` holds."""
+
+    cell: dict[str, Any]  # name, sha256, source
+    searcher: str
+    params: dict[str, Any]  # the searcher's options (defaults filled in)
+    seed: int
+    budget: int
+    until: str
+    found: bool
+    episodes: int  # used, up to and including the first hazard (until=first) or the whole budget
+    hazard: dict[str, Any] | None  # the first hazardous episode, with its trace
+    hazards: list[dict[str, Any]]  # every hazardous episode: {episode, actions}
+    top: list[dict[str, Any]]  # the top-k episodes by return: {episode, actions, return, risk, unsafe}
+    risk_per_episode: list[float]  # max 1/c_S of each episode
+    version: str
+    format: int = FORMAT
+
+    def to_dict(self) -> dict[str, Any]:
+        return json_ready(asdict(self))
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), sort_keys=True, indent=1, allow_nan=False) + "\n"
+
+    def write(self, out_dir: str | Path) -> Path:
+        """Write ``out_dir/result.json`` atomically; returns its path."""
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        path = out / FILE_NAME
+        fd, tmp = tempfile.mkstemp(prefix=".result-", suffix=".json.tmp", dir=out)
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+                f.write(self.to_json())
+                f.flush()
+                os.fsync(f.fileno())
+            os.replace(tmp, path)
+        except BaseException:
+            try:
+                os.unlink(tmp)
+            except FileNotFoundError:
+                pass
+            raise
+        return path
+
+    @classmethod
+    def from_dict(cls, doc: dict[str, Any]) -> SearchResult:
+        return cls(**doc)
+
+    @classmethod
+    def load(cls, path: str | Path) -> SearchResult:
+        p = Path(path)
+        if p.is_dir():
+            p = p / FILE_NAME
+        try:
+            doc = json.loads(p.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            raise SearchError(f"{p}: no such result file") from None
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise SearchError(f"{p}: not a readable result file ({exc})") from None
+        fields = set(cls.__dataclass_fields__)
+        if not isinstance(doc, dict) or not {"cell", "hazard", "searcher"} <= set(doc) or set(doc) - fields:
+            raise SearchError(f"{p}: not a cellstress result file")
+        try:
+            return cls.from_dict(doc)
+        except TypeError as exc:
+            raise SearchError(f"{p}: not a cellstress result file ({exc})") from None

@@ -1,0 +1,143 @@
+"""`cellstress search` and `cellstress replay`: files, summary, --json, exit codes."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from cellstress.cli import main
+
+
+def _run(args, capsys):
+    code = main(args)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_search_summary_and_replay(tmp_path, capsys) -> None:
+    code, out, err = _run(["search", "s3-fence-gap", "--searcher", "mcts-commit", "--out", str(tmp_path)], capsys)
+    assert code == 0, err
+    doc = json.loads((tmp_path / "result.json").read_text())
+    h = doc["hazard"]
+    lines = out.splitlines()
+    assert lines[0].startswith("cell      s3-fence-gap  searcher mcts-commit (n auto, ec 0.5, k 1, alpha 0.85)")
+    assert lines[1].startswith(f"FOUND at episode {h['episode']} of 200 ")
+    assert "episodes/s" in lines[1]
+    assert lines[2] == "actions   " + ", ".join(h["actions"])
+    assert lines[3].startswith(f"contact   t={h['time_s']:g} s (step {h['step']}): {h['robot_link']} / "
+                               f"{h['body_part']} at (")
+    assert lines[-1] == f"wrote     {tmp_path / 'result.json'}"
+    code, out, err = _run(["replay", str(tmp_path / "result.json")], capsys)
+    assert code == 0, err
+    rows = out.splitlines()
+    assert rows[0].split()[:3] == ["step", "t[s]", "x[m]"]
+    assert len(rows) == 1 + len(h["trace"]) + 1
+    assert rows[-1].startswith("REPRODUCED bit-exactly")
+    code, out, _ = _run(["replay", str(tmp_path)], capsys)  # the folder works too
+    assert code == 0
+
+
+def test_search_json_is_the_file(tmp_path, capsys) -> None:
+    code, out, err = _run(["search", "s3-fence-gap", "--budget", "30", "--seed", "2", "--searcher", "random",
+                           "--out", str(tmp_path), "--json", "--until", "budget"], capsys)
+    assert code == 0
+    assert out == (tmp_path / "result.json").read_text()
+    doc = json.loads(out)
+    assert doc["episodes"] == 30 and doc["until"] == "budget" and doc["seed"] == 2
+    assert "episodes/s" in err  # timing goes to the console, never into the file
+    assert not any("time" in k or "clock" in k or "date" in k for k in doc)
+
+
+def test_replay_detects_a_changed_trace(tmp_path, capsys) -> None:
+    assert _run(["search", "s3-fence-gap", "--out", str(tmp_path)], capsys)[0] == 0
+    path = tmp_path / "result.json"
+    doc = json.loads(path.read_text())
+    row = doc["hazard"]["trace"][-2]
+    row["d_HR"] = math.nextafter(row["d_HR"], math.inf)  # one ulp off
+    path.write_text(json.dumps(doc))
+    code, out, _ = _run(["replay", str(path)], capsys)
+    assert code == 1
+    assert f"MISMATCH: row {len(doc['hazard']['trace']) - 2} differs in d_HR" in out
+
+
+def test_replay_detects_a_changed_cell(tmp_path, capsys) -> None:
+    assert _run(["search", "s3-fence-gap", "--out", str(tmp_path)], capsys)[0] == 0
+    path = tmp_path / "result.json"
+    doc = json.loads(path.read_text())
+    doc["cell"]["sha256"] = "0" * 64
+    path.write_text(json.dumps(doc))
+    code, out, _ = _run(["replay", str(path)], capsys)
+    assert code == 1 and "MISMATCH: the cell differs" in out
+
+
+def test_replay_without_hazard_or_file_is_a_user_error(tmp_path, capsys) -> None:
+    assert _run(["search", "baseline", "--budget", "3", "--out", str(tmp_path)], capsys)[0] == 0
+    code, _, err = _run(["replay", str(tmp_path / "result.json")], capsys)
+    assert code == 2 and err.startswith("error: ") and "no hazard" in err and err.count("\n") == 1
+    code, _, err = _run(["replay", str(tmp_path / "nope.json")], capsys)
+    assert code == 2 and "no such result file" in err and err.count("\n") == 1
+    (tmp_path / "bad.json").write_text("{}")
+    code, _, err = _run(["replay", str(tmp_path / "bad.json")], capsys)
+    assert code == 2 and "not a cellstress result file" in err
+
+
+@pytest.mark.parametrize(
+    "extra,words",
+    [
+        (["--searcher", "annealing"], ["unknown searcher 'annealing'", "random, mcts, mcts-commit"]),
+        (["--budget", "0"], ["budget", ">= 1"]),
+        (["--seed", "-1"], ["seed", ">= 0"]),
+        (["--until", "never"], ["until", "first, budget"]),
+        (["--searcher", "random", "--ec", "2"], ["'random' has no option ec"]),
+        (["--ec", "-1"], ["ec must be"]),
+        (["--searcher", "mcts-commit", "--n", "0"], ["n must be"]),
+        (["--budget", "ten"], ["budget"]),
+    ],
+)
+def test_bad_options_exit_2_with_one_line(tmp_path, capsys, extra, words) -> None:
+    code, out, err = _run(["search", "s1-scanner-width", "--out", str(tmp_path), *extra], capsys)
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), err
+    for w in words:
+        assert w in lines[0]
+    assert not (tmp_path / "result.json").exists()
+
+
+def test_unwritable_out_exits_2(tmp_path, capsys) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    code, _, err = _run(["search", "s1-scanner-width", "--out", str(blocker / "sub")], capsys)
+    assert code == 2 and err.startswith(f"error: --out {blocker / 'sub'}: cannot write there")
+    code, _, err = _run(["search", "s1-scanner-width", "--out", str(blocker)], capsys)
+    assert code == 2 and "exists and is not a directory" in err
+
+
+def test_unknown_cell_exits_2(tmp_path, capsys) -> None:
+    code, _, err = _run(["search", "no-such-cell", "--out", str(tmp_path)], capsys)
+    assert code == 2 and err.startswith("error: no-such-cell: no such file")
+
+
+def test_search_and_replay_a_cell_file_from_another_folder(tmp_path, capsys, monkeypatch) -> None:
+    from importlib import resources
+
+    text = resources.files("cellstress.cell").joinpath("builtin", "s3-fence-gap.yaml").read_text(encoding="utf-8")
+    (tmp_path / "cells").mkdir()
+    (tmp_path / "cells" / "mine.yaml").write_text(text, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    code, _, err = _run(["search", "cells/mine.yaml", "--out", "out"], capsys)
+    assert code == 0, err
+    doc = json.loads((tmp_path / "out" / "result.json").read_text())
+    assert doc["cell"]["source"] == str(tmp_path / "cells" / "mine.yaml") and doc["found"]
+    (tmp_path / "elsewhere").mkdir()
+    monkeypatch.chdir(tmp_path / "elsewhere")
+    code, out, err = _run(["replay", "../out/result.json"], capsys)
+    assert code == 0, err
+    assert out.splitlines()[-1].startswith("REPRODUCED bit-exactly")
+
+
+def test_out_is_required(capsys) -> None:
+    code, _, err = _run(["search", "s1-scanner-width"], capsys)
+    assert code == 2 and err.startswith("error: Missing option '--out'") and err.count("\n") == 1
