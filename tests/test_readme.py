@@ -29,19 +29,25 @@ def test_readme_starts_with_the_two_commands():
     assert second in ci  # CI runs exactly the README's test command
 
 
-def test_first_command_runs_the_main_job():
-    job = BLOCKS[0][1].strip().split("&& cellstress ", 1)[1]
-    out = _cli(shlex.split(job))
+def test_first_command_runs_the_main_job(tmp_path):
+    job = shlex.split(BLOCKS[0][1].strip().split("&& cellstress ", 1)[1])
+    job[job.index("--out") + 1] = str(tmp_path / "s3")
+    out = _cli(job)
     assert out.returncode == 0, out.stderr
-    assert out.stdout.strip().splitlines()[-1].startswith("UNSAFE at t=0.6 s (step 12)")
+    assert "FOUND at episode" in out.stdout
+    assert (tmp_path / "s3" / "result.json").is_file()
 
 
-@pytest.mark.parametrize("line", [ln for lang, body in BLOCKS[2:] if lang == "bash"
-                                  for ln in body.strip().splitlines() if ln.startswith("cellstress ")])
-def test_cli_examples(line):
-    out = _cli(shlex.split(line)[1:])
-    assert out.returncode == 0, out.stderr
-    assert out.stdout.strip()
+def test_cli_examples(tmp_path):
+    """In order, in one folder: `replay` reads what `search` wrote."""
+    lines = [ln for lang, body in BLOCKS[2:] if lang == "bash"
+             for ln in body.strip().splitlines() if ln.startswith("cellstress ")]
+    assert len(lines) >= 7
+    for line in lines:
+        out = subprocess.run([sys.executable, "-m", "cellstress", *shlex.split(line)[1:]], capture_output=True,
+                             text=True, cwd=tmp_path, timeout=600)
+        assert out.returncode == 0, (line, out.stderr)
+        assert out.stdout.strip(), line
 
 
 def test_python_examples(capsys):
@@ -49,4 +55,5 @@ def test_python_examples(capsys):
         if lang == "python":
             exec(compile(body, "README.md", "exec"), {})
     printed = capsys.readouterr().out.split()
-    assert printed[:3] == ["0.6", "upper_arm_link", "left-reach"]
+    assert printed[:2] == ["True", "75"]
+    assert printed[2:5] == ["0.6", "upper_arm_link", "left-reach"]
