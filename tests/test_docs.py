@@ -1,0 +1,29 @@
+"""Every `cellstress ...` command shown in docs/*.md runs and exits 0 (the Python blocks of docs/cells.md are
+run by tests/cell/test_iso13855.py)."""
+
+from __future__ import annotations
+
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+DOCS = Path(__file__).resolve().parents[1] / "docs"
+COMMANDS = [(p.name, ln.strip()) for p in sorted(DOCS.glob("*.md"))
+            for lang, body in re.findall(r"```(\w*)\n(.*?)```", p.read_text(encoding="utf-8"), flags=re.S)
+            if lang in ("bash", "console", "sh") for ln in body.splitlines() if ln.strip().startswith("cellstress ")]
+
+
+def test_docs_show_commands():
+    assert COMMANDS
+
+
+@pytest.mark.parametrize(("doc", "line"), COMMANDS)
+def test_doc_command_runs(doc, line, tmp_path):
+    out = subprocess.run([sys.executable, "-m", "cellstress", *shlex.split(line)[1:]], capture_output=True,
+                         text=True, cwd=tmp_path, timeout=600)
+    assert out.returncode == 0, (doc, line, out.stderr)
+    assert out.stdout.strip()
