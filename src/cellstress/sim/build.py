@@ -16,6 +16,7 @@ from cellstress.robot.model import RobotModel, load_robot, resolve_urdf
 from cellstress.robot.trajectory import Trajectory, build_trajectory
 from cellstress.sim import kernels as K
 
+
 @dataclass(frozen=True)
 class Layout:
     """Everything the simulator knows about a cell, with the names that go into reports."""
