@@ -1,3 +1,5 @@
+import sys
+
 from cellstress.cli import main
 
-main()
+sys.exit(main())

@@ -405,6 +405,12 @@ def replay(
                f"{h['robot_link']} / {h['body_part']}, v_R {h['v_R']:.3f} m/s")
 
 
+# ---- campaign (the command lives in cellstress/campaign/cli.py) -------------------------------------------
+from cellstress.campaign.cli import campaign  # noqa: E402
+
+app.command()(campaign)
+
+
 # ---- entry point ------------------------------------------------------------------------------------------
 def main(argv: list[str] | None = None) -> int:
     """The ``cellstress`` console script. Returns the exit code (0 ok, 2 user error)."""

@@ -1,0 +1,142 @@
+"""Where runs execute: in this process, in local worker processes, or on a Ray cluster.
+
+Each backend takes the runs still to do and yields their records as they finish (in any order); the caller
+appends each one to ``runs.jsonl`` at once. A run is a pure function of its ``RunSpec``, so the backends give
+the same records; only the order differs, and ``runs.jsonl`` lines are compared sorted.
+
+Worker processes are started with ``spawn``, not ``fork``: numba's thread pool (and the threads of a Ray
+driver) do not survive a fork, and a forked child could inherit a half-held lock.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from typing import Any
+
+from cellstress.campaign.plan import CampaignError, RunSpec
+from cellstress.campaign.worker import execute, execute_threaded, init_worker
+
+BACKENDS = ("processes", "ray")
+RAY_HINT = "pip install 'cellstress[ray]'"
+
+
+def cpu_count() -> int:
+    """Cores this process may use (the affinity mask, not the machine's total, where the OS tells it)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+@dataclass(frozen=True)
+class Backend:
+    """How to execute: ``name`` in BACKENDS; ``workers`` (None: all cores, or the Ray cluster's CPUs);
+    ``address`` of a Ray cluster (None: start a local one, or use the one this process already joined)."""
+
+    name: str = "processes"
+    workers: int | None = None
+    address: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.name not in BACKENDS:
+            raise CampaignError(f"--backend must be one of {', '.join(BACKENDS)}, not {self.name!r}")
+        if self.workers is not None and (isinstance(self.workers, bool) or not isinstance(self.workers, int)
+                                         or self.workers < 1):
+            raise CampaignError(f"--workers must be a whole number >= 1, not {self.workers!r}")
+        if self.address is not None and self.name != "ray":
+            raise CampaignError("--address is the address of a Ray cluster: use it with --backend ray")
+
+    def describe(self, n_runs: int) -> str:
+        if self.name == "ray":
+            return "Ray" + (f" at {self.address}" if self.address else "") + \
+                (f", at most {self.workers} tasks at a time" if self.workers else "")
+        w = self.local_workers(n_runs)
+        return "1 worker (this process)" if w == 1 else f"{w} worker processes"
+
+    def local_workers(self, n_runs: int) -> int:
+        return max(1, min(self.workers or cpu_count(), n_runs))
+
+    def run(self, specs: list[RunSpec]) -> Iterator[dict[str, Any]]:
+        """The records of ``specs``, each as soon as its run has finished."""
+        if not specs:
+            return iter(())
+        if self.name == "ray":
+            return run_ray(specs, self.workers, self.address)
+        w = self.local_workers(len(specs))
+        return run_serial(specs) if w == 1 else run_processes(specs, w)
+
+
+def run_serial(specs: Iterable[RunSpec]) -> Iterator[dict[str, Any]]:
+    """In this process, one after the other (numba keeps its default threads: random search batches use
+    every core)."""
+    for spec in specs:
+        yield execute(spec)
+
+
+def run_processes(specs: list[RunSpec], workers: int) -> Iterator[dict[str, Any]]:
+    """A pool of ``workers`` spawned processes, one numba thread each; each keeps its simulators."""
+    import multiprocessing
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(workers, mp_context=ctx, initializer=init_worker, initargs=(1,)) as pool:
+        pending = {pool.submit(execute, s) for s in specs}
+        try:
+            while pending:
+                done, pending = wait(pending, return_when=FIRST_COMPLETED)
+                for f in sorted(done, key=id):
+                    yield f.result()
+        finally:
+            # interrupted, or a run failed: drop what has not started; the pool's exit waits for the
+            # runs in progress (well under a second each) and stops the workers
+            for f in pending:
+                f.cancel()
+
+
+def _ray():
+    try:
+        import ray
+    except ImportError:
+        raise CampaignError(f"--backend ray needs Ray, which is not installed ({RAY_HINT})") from None
+    return ray
+
+
+def run_ray(specs: list[RunSpec], max_in_flight: int | None, address: str | None) -> Iterator[dict[str, Any]]:
+    """Ray tasks of one CPU each. Joins the cluster at ``address``; without one, uses the Ray this process
+    already joined, or starts a local Ray on this machine's cores (and stops it afterwards)."""
+    import logging
+
+    ray = _ray()
+    started = False
+    if not ray.is_initialized():
+        kwargs: dict[str, Any] = {"address": address, "include_dashboard": False,
+                                  "logging_level": logging.WARNING}
+        if address is None:
+            kwargs["num_cpus"] = max_in_flight or cpu_count()
+        try:
+            ray.init(**kwargs)
+        except (ConnectionError, ValueError, RuntimeError) as exc:
+            raise CampaignError(f"--address {address}: cannot join the Ray cluster ({exc})") from None
+        started = True
+    task = ray.remote(num_cpus=1)(execute_threaded)
+    limit = max_in_flight or len(specs)
+    queue = list(reversed(specs))
+    running: list[Any] = []
+    try:
+        while queue or running:
+            while queue and len(running) < limit:
+                running.append(task.remote(queue.pop(), 1))
+            done, running = ray.wait(running, num_returns=1)
+            for ref in done:
+                try:
+                    yield ray.get(ref)
+                except ray.exceptions.RayTaskError as exc:
+                    cause = getattr(exc, "cause", None)
+                    raise cause if isinstance(cause, Exception) else exc from None
+    finally:
+        for ref in running:
+            ray.cancel(ref, force=True)
+        if started:
+            ray.shutdown()

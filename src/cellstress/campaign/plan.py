@@ -1,0 +1,221 @@
+"""The campaign's options, its run grid and its manifest (``DIR/campaign.json``).
+
+A run is a pure function of (cell, searcher, seed, budget, searcher options): the same inputs give the same
+record on any worker, so the grid can be cut into tasks in any order and a campaign can be resumed. The
+manifest pins everything a run's outcome depends on (cell hashes, searcher options, budget, seeds, the
+cellstress version); a resumed campaign must match it, or its runs would silently mix two experiments.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from cellstress.errors import CellstressError
+
+FORMAT = 1
+MANIFEST = "campaign.json"
+# the paper's experiment (Huck et al. 2020, Sec. V): three flawed scenarios, MCTS1/MCTS2 against random
+DEFAULT_CELLS: tuple[str, ...] = ("s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap")
+DEFAULT_SEARCHERS: tuple[str, ...] = ("random", "mcts", "mcts-commit")
+DEFAULT_SEEDS = 10
+DEFAULT_BUDGET = 200
+UNTIL = "first"  # the paper stops a run at its first hazard; a failed run counts as the budget
+
+
+class CampaignError(CellstressError):
+    """A bad campaign option, or an --out folder that holds another campaign."""
+
+
+@dataclass(frozen=True)
+class CellRef:
+    """A cell as the workers load it: ``source`` is a built-in name or an absolute path."""
+
+    name: str
+    source: str
+    sha256: str
+
+
+@dataclass(frozen=True)
+class SearcherRef:
+    """A searcher by its registry name, with its options (the defaults, filled in)."""
+
+    name: str
+    params: tuple[tuple[str, Any], ...]  # sorted (option, value) pairs: hashable and picklable
+
+    @property
+    def params_dict(self) -> dict[str, Any]:
+        return dict(self.params)
+
+
+@dataclass(frozen=True)
+class RunKey:
+    cell: str
+    searcher: str
+    seed: int
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """Everything a worker needs for one run (pickled to worker processes and Ray tasks)."""
+
+    cell: CellRef
+    searcher: SearcherRef
+    seed: int
+    budget: int
+
+    @property
+    def key(self) -> RunKey:
+        return RunKey(self.cell.name, self.searcher.name, self.seed)
+
+
+@dataclass(frozen=True)
+class CampaignPlan:
+    """The resolved options of a campaign: what it runs, not how (workers and backend are not part of it)."""
+
+    cells: tuple[CellRef, ...]
+    searchers: tuple[SearcherRef, ...]
+    seeds: int
+    budget: int
+    version: str
+
+    def runs(self) -> list[RunSpec]:
+        """The grid in table order: cell, searcher, seed."""
+        return [RunSpec(c, s, seed, self.budget) for c in self.cells for s in self.searchers
+                for seed in range(self.seeds)]
+
+    def manifest(self) -> dict[str, Any]:
+        return {
+            "format": FORMAT,
+            "cellstress_version": self.version,
+            "cells": [{"name": c.name, "source": c.source, "sha256": c.sha256} for c in self.cells],
+            "searchers": [{"name": s.name, "params": s.params_dict} for s in self.searchers],
+            "seeds": list(range(self.seeds)),
+            "budget": self.budget,
+            "until": UNTIL,
+            "runs": len(self.cells) * len(self.searchers) * self.seeds,
+        }
+
+
+def split_names(values: list[str] | tuple[str, ...] | None, default: tuple[str, ...], what: str) -> tuple[str, ...]:
+    """``--cells a,b --cells c`` -> (a, b, c); the default when not given; duplicates are an error."""
+    if not values:
+        return default
+    names = tuple(n.strip() for v in values for n in str(v).split(",") if n.strip())
+    if not names:
+        raise CampaignError(f"--{what}: no names given")
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise CampaignError(f"--{what}: {', '.join(twice)} listed more than once")
+    return names
+
+
+def resolve(cells: tuple[str, ...], searchers: tuple[str, ...], seeds: int, budget: int) -> CampaignPlan:
+    """Check the options and pin them: load every cell (its hash) and fill in each searcher's defaults.
+
+    Raises ``CampaignError`` (or the cell's ``CellError``) for anything the user must fix."""
+    from dataclasses import asdict
+
+    from cellstress import __version__
+    from cellstress.cell.load import BUILTIN_CELLS, load_cell
+    from cellstress.search import SEARCHERS, make_searcher
+
+    for opt, value in (("seeds", seeds), ("budget", budget)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise CampaignError(f"--{opt} must be a whole number >= 1, not {value!r}")
+    unknown = [s for s in searchers if s not in SEARCHERS]
+    if unknown:
+        raise CampaignError(f"--searchers: unknown searcher {unknown[0]!r} (choose from {', '.join(SEARCHERS)})")
+    refs = []
+    for ref in cells:
+        c = load_cell(ref)
+        # a file by its absolute path, so that workers (and a resume from another folder) find it
+        source = ref if ref in BUILTIN_CELLS else str(Path(ref).expanduser().resolve())
+        refs.append(CellRef(c.name, source, c.sha256))
+    names = [r.name for r in refs]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise CampaignError(f"--cells: two cells are named {twice[0]!r}; rows of the table are keyed by name")
+    srefs = tuple(SearcherRef(s, tuple(sorted(asdict(make_searcher(s)).items()))) for s in searchers)
+    return CampaignPlan(tuple(refs), srefs, int(seeds), int(budget), __version__)
+
+
+def _show(value: Any) -> str:
+    if isinstance(value, list):
+        return ",".join(_show(v) for v in value) or "(none)"
+    if isinstance(value, dict):
+        return json.dumps(value, sort_keys=True)
+    return str(value)
+
+
+def manifest_difference(old: dict[str, Any], new: dict[str, Any]) -> str | None:
+    """The first option in which two manifests differ, as one readable phrase; None if they agree."""
+    if old.get("format") != new["format"]:
+        return f"the folder's campaign.json has format {old.get('format')!r}, this cellstress writes {new['format']}"
+    old_cells, new_cells = old.get("cells", []), new["cells"]
+    if [c.get("name") for c in old_cells] != [c["name"] for c in new_cells]:
+        return (f"--cells differs: {_show([c.get('name') for c in old_cells])} there, "
+                f"{_show([c['name'] for c in new_cells])} here")
+    for a, b in zip(old_cells, new_cells, strict=True):
+        if a.get("sha256") != b["sha256"]:
+            return (f"cell {b['name']} has changed since the campaign started (sha256 "
+                    f"{str(a.get('sha256'))[:12]} there, {b['sha256'][:12]} here)")
+    old_s, new_s = old.get("searchers", []), new["searchers"]
+    if [s.get("name") for s in old_s] != [s["name"] for s in new_s]:
+        return (f"--searchers differs: {_show([s.get('name') for s in old_s])} there, "
+                f"{_show([s['name'] for s in new_s])} here")
+    for a, b in zip(old_s, new_s, strict=True):
+        if a.get("params") != b["params"]:
+            return (f"searcher {b['name']}'s default options have changed ({_show(a.get('params'))} there, "
+                    f"{_show(b['params'])} here)")
+    if old.get("seeds") != new["seeds"]:
+        return f"--seeds differs: {len(old.get('seeds') or [])} there, {len(new['seeds'])} here"
+    for key, label in (("budget", "--budget"), ("until", "until"), ("cellstress_version", "cellstress version")):
+        if old.get(key) != new[key]:
+            return f"{label} differs: {_show(old.get(key))} there, {_show(new[key])} here"
+    return None
+
+
+def write_json_atomic(path: Path, doc: Any) -> None:
+    """Write ``doc`` as sorted, indented JSON through a temporary file and ``os.replace`` (never half a file)."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}-", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+            f.write(json.dumps(doc, sort_keys=True, indent=1, allow_nan=False) + "\n")
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+
+
+def open_manifest(out: Path, plan: CampaignPlan) -> bool:
+    """Write ``out/campaign.json``, or check that the one there matches ``plan``. True if it existed."""
+    from cellstress.campaign.store import RUNS
+
+    path = out / MANIFEST
+    new = plan.manifest()
+    if not path.exists():
+        if (out / RUNS).exists():
+            raise CampaignError(f"--out {out}: has a {RUNS} but no {MANIFEST}; use an empty folder")
+        write_json_atomic(path, new)
+        return False
+    try:
+        old = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise CampaignError(f"--out {out}: {MANIFEST} is not readable ({exc})") from None
+    if not isinstance(old, dict):
+        raise CampaignError(f"--out {out}: {MANIFEST} is not a campaign manifest")
+    diff = manifest_difference(old, new)
+    if diff is not None:
+        raise CampaignError(f"--out {out} holds a campaign with other options: {diff} "
+                            f"(resume with the same options, or use another --out)")
+    return True

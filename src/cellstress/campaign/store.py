@@ -1,0 +1,150 @@
+"""``DIR/runs.jsonl``: one line per finished run, appended, flushed and fsynced when the run ends.
+
+Only the main process writes, one whole line per ``os.write`` on an ``O_APPEND`` descriptor, so a crash can
+leave at most a truncated last line. Reading tolerates exactly that: the partial line is dropped (the file is
+rewritten without it, atomically) and its run is done again. Lines are JSON with sorted keys and no
+wall-clock field, so sorting the lines of two campaigns' files gives byte-identical text whatever the order
+in which runs finished.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from cellstress.campaign.plan import MANIFEST, CampaignError, CampaignPlan, RunKey
+from cellstress.search.result import json_ready
+
+RUNS = "runs.jsonl"
+LOCK = ".campaign.lock"
+
+
+def dumps(record: dict[str, Any]) -> str:
+    """A record as one line of text (no newline): sorted keys, no spaces, no NaN."""
+    return json.dumps(json_ready(record), sort_keys=True, separators=(",", ":"), allow_nan=False)
+
+
+def record_key(rec: dict[str, Any]) -> RunKey:
+    return RunKey(str(rec["cell"]), str(rec["searcher"]), int(rec["seed"]))
+
+
+@dataclass(frozen=True)
+class Loaded:
+    """What ``read_runs`` found: the records by run, and whether a truncated last line was dropped."""
+
+    records: dict[RunKey, dict[str, Any]]
+    dropped_partial: bool
+
+
+def read_runs(path: Path, plan: CampaignPlan) -> Loaded:
+    """Read ``runs.jsonl``; repair a truncated last line; check every line belongs to ``plan``."""
+    if not path.exists():
+        return Loaded({}, False)
+    raw = path.read_bytes()
+    lines = raw.split(b"\n")
+    tail = lines.pop()  # b"" when the file ends with a newline, else a line cut short by a crash
+    dropped = bool(tail)
+    if dropped:
+        _rewrite(path, raw[: len(raw) - len(tail)])
+    expected = {s.key: s for s in plan.runs()}
+    records: dict[RunKey, dict[str, Any]] = {}
+    for n, line in enumerate(lines, start=1):
+        if not line.strip():
+            continue
+        try:
+            rec = json.loads(line)
+            key = record_key(rec)
+        except (UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError, ValueError):
+            raise CampaignError(f"{path}: line {n} is not a run record; the file is damaged (move it away to "
+                                f"start over)") from None
+        spec = expected.get(key)
+        if spec is None or rec.get("budget") != spec.budget or rec.get("cell_sha256") != spec.cell.sha256 \
+                or rec.get("params") != json_ready(spec.searcher.params_dict):
+            raise CampaignError(f"{path}: line {n} ({key.cell}, {key.searcher}, seed {key.seed}) is not a run "
+                                f"of the campaign in {MANIFEST}")
+        old = records.get(key)
+        if old is not None and dumps(old) != dumps(rec):
+            raise CampaignError(f"{path}: line {n} repeats run ({key.cell}, {key.searcher}, seed {key.seed}) "
+                                f"with a different outcome")
+        records[key] = rec
+    return Loaded(records, dropped)
+
+
+def _rewrite(path: Path, data: bytes) -> None:
+    """Replace ``path`` by ``data`` atomically (a crash leaves the old or the new file, never a mix)."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}-", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+
+
+def rewrite_text(path: Path, text: str) -> None:
+    """Write a whole text file atomically."""
+    _rewrite(path, text.encode("utf-8"))
+
+
+class RunWriter:
+    """Appends records to ``runs.jsonl``: one ``os.write`` of a whole line, then fsync."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self._fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+
+    def append(self, record: dict[str, Any]) -> None:
+        data = (dumps(record) + "\n").encode("utf-8")
+        view = memoryview(data)
+        while view:  # a regular file takes the whole line at once; loop only for safety
+            n = os.write(self._fd, view)
+            view = view[n:]
+        os.fsync(self._fd)
+
+    def close(self) -> None:
+        if self._fd >= 0:
+            os.close(self._fd)
+            self._fd = -1
+
+    def __enter__(self) -> RunWriter:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+class FolderLock:
+    """An exclusive lock on the --out folder, so two campaigns cannot append to the same runs.jsonl."""
+
+    def __init__(self, out: Path):
+        self.path = out / LOCK
+        self._f = None
+
+    def __enter__(self) -> FolderLock:
+        try:
+            import fcntl
+        except ImportError:  # not on POSIX: no lock, as before
+            return self
+        self._f = open(self.path, "a")  # noqa: SIM115 - held open for the lock's lifetime
+        try:
+            fcntl.flock(self._f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self._f.close()
+            self._f = None
+            raise CampaignError(f"--out {self.path.parent}: another campaign is running there") from None
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._f is not None:
+            self._f.close()  # closing releases the lock
+            self._f = None
