@@ -48,6 +48,11 @@ class Backend:
         if self.address is not None and self.name != "ray":
             raise CampaignError("--address is the address of a Ray cluster: use it with --backend ray")
 
+    def check(self) -> None:
+        """Fail early (before the --out folder is touched) when the backend cannot run here."""
+        if self.name == "ray":
+            _ray()
+
     def describe(self, n_runs: int) -> str:
         if self.name == "ray":
             return "Ray" + (f" at {self.address}" if self.address else "") + \

@@ -44,6 +44,7 @@ def campaign(
 
     with _user_errors():
         how = Backend(backend, workers, address)
+        how.check()
         plan = resolve(split_names(cells, DEFAULT_CELLS, "cells"), split_names(searchers, DEFAULT_SEARCHERS,
                        "searchers"), seeds, budget)
     out_dir: Path = _check_out_dir(out)

@@ -132,7 +132,10 @@ def resolve(cells: tuple[str, ...], searchers: tuple[str, ...], seeds: int, budg
         raise CampaignError(f"--searchers: unknown searcher {unknown[0]!r} (choose from {', '.join(SEARCHERS)})")
     refs = []
     for ref in cells:
-        c = load_cell(ref)
+        try:
+            c = load_cell(ref)
+        except CellstressError as exc:
+            raise CampaignError(f"--cells: {exc}") from None
         # a file by its absolute path, so that workers (and a resume from another folder) find it
         source = ref if ref in BUILTIN_CELLS else str(Path(ref).expanduser().resolve())
         refs.append(CellRef(c.name, source, c.sha256))

@@ -6,6 +6,7 @@ no wall-clock field), so the same grid gives the same records on one worker, man
 
 from __future__ import annotations
 
+import os
 from typing import Any
 
 from cellstress.campaign.plan import CampaignError, RunSpec
@@ -26,7 +27,28 @@ def init_worker(threads: int | None = 1) -> None:
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _exit_with_parent()
     set_threads(threads)
+
+
+def _exit_with_parent() -> None:
+    """End this worker when the main process dies (e.g. SIGKILL), instead of waiting for work forever.
+
+    A pool worker holds both ends of its task queue's pipe, so it never sees end-of-file when the main process
+    is killed; the parent's sentinel becomes ready when it exits, whatever the cause."""
+    import multiprocessing
+    import threading
+    from multiprocessing.connection import wait
+
+    parent = multiprocessing.parent_process()
+    if parent is None:
+        return
+
+    def watch() -> None:
+        wait([parent.sentinel])
+        os._exit(1)  # no clean-up to do: the main process owns runs.jsonl
+
+    threading.Thread(target=watch, name="cellstress-parent-watch", daemon=True).start()
 
 
 def set_threads(threads: int | None) -> None:
