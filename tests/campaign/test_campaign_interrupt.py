@@ -124,3 +124,37 @@ def test_sigint_stops_cleanly_then_resume(tmp_path, capsys, reference, workers):
     assert not (tmp_path / "table.md").exists()  # the table is written when the grid is complete
     _resume_and_check(tmp_path, capsys)
     assert sorted((tmp_path / RUNS).read_text().splitlines()) == reference
+
+
+def _workers_of(pid: int) -> list[int]:
+    """Pool worker processes of ``pid`` (Linux /proc): children running multiprocessing's spawn_main."""
+    found = []
+    for d in Path("/proc").glob("[0-9]*"):
+        try:
+            stat = (d / "stat").read_text()
+            cmd = (d / "cmdline").read_bytes()
+        except OSError:
+            continue
+        if int(stat[stat.rindex(")") + 2:].split()[1]) == pid and b"spawn_main" in cmd:
+            found.append(int(d.name))
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="finds the worker through /proc")
+def test_a_dead_worker_stops_the_campaign_with_its_runs_saved(tmp_path, capsys, reference):
+    proc = _start(tmp_path, 2)
+    try:
+        _wait_for_lines(proc, tmp_path, 3)
+        workers = _workers_of(proc.pid)
+        assert workers
+        os.kill(workers[0], signal.SIGKILL)  # as the out-of-memory killer would
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 1, err
+    assert "a worker process died" in err and "run the same command again to resume" in err
+    assert "Traceback" not in err
+    assert (tmp_path / RUNS).read_text().endswith("\n")
+    _resume_and_check(tmp_path, capsys)
+    assert sorted((tmp_path / RUNS).read_text().splitlines()) == reference

@@ -77,6 +77,13 @@ def test_a_failed_run_counts_as_the_budget_even_if_its_episodes_say_otherwise():
     assert rows[0].mean_episodes == 30.0
 
 
+def test_paper_numbers_only_at_the_papers_budget():
+    recs = [dict(r, budget=50, episodes=min(r["episodes"], 50)) for r in RECORDS]
+    rows = summarize(recs, [CELL], ["random", "mcts"], 50)
+    assert all(r.paper is None and r.paper_ratio_to_random is None for r in rows)
+    assert rows[1].ratio_to_random == pytest.approx(25 / ((20 + 50 + 50 + 50) / 4))
+
+
 def test_no_random_no_ratio_and_unknown_pairs_have_no_paper_numbers():
     recs = [dict(r, cell="baseline") for r in RECORDS if r["searcher"] == "mcts"]
     (row,) = summarize(recs, ["baseline"], ["mcts"], 200)

@@ -35,6 +35,7 @@ def campaign(
 
     Defaults: the paper's experiment, 3 flawed cells x random, mcts, mcts-commit x 10 seeds, budget 200."""
     import time
+    from concurrent.futures.process import BrokenProcessPool
     from pathlib import Path
 
     from cellstress.campaign import DEFAULT_CELLS, DEFAULT_SEARCHERS, Backend, resolve, run_campaign
@@ -80,6 +81,10 @@ def campaign(
         typer.echo(f"interrupted: {state['done']} of {len(plan.runs())} runs are in {out_dir / 'runs.jsonl'}; "
                    "run the same command again to resume", err=True)
         raise typer.Exit(INTERRUPTED) from None
+    except BrokenProcessPool as exc:  # a worker was killed (out of memory, a signal): not the user's fault
+        typer.echo(f"error: a worker process died ({exc}); {state['done']} of {len(plan.runs())} runs are in "
+                   f"{out_dir / 'runs.jsonl'}; run the same command again to resume", err=True)
+        raise typer.Exit(1) from None
     except OSError as exc:
         raise _fail(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
     elapsed = time.perf_counter() - t0

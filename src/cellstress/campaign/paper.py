@@ -23,6 +23,7 @@ class PaperRow:
 @dataclass(frozen=True)
 class PaperTable:
     citation: str
+    budget: int  # episodes per run in the paper's experiment
     rows: tuple[tuple[tuple[str, str], PaperRow], ...]  # ((cell, searcher), row), hashable for the cache
 
     def get(self, cell: str, searcher: str) -> PaperRow | None:
@@ -39,4 +40,4 @@ def paper_table() -> PaperTable:
     rows = tuple(((cell_of[r["scenario"]], searcher_of[r["algorithm"]]),
                   PaperRow(int(r["found"]), int(doc["runs"]), float(r["mean_episodes"]), int(doc["budget"])))
                  for r in doc["results"])
-    return PaperTable(str(doc["citation"]), rows)
+    return PaperTable(str(doc["citation"]), int(doc["budget"]), rows)

@@ -10,7 +10,8 @@ Per cell and searcher:
   with runs censored at the budget it is approximate, which the clip makes visible;
 - the median (the mean of the two middle values for even n);
 - the mean as a ratio of random's mean in the same cell (the paper's claim is about this ratio);
-- Huck et al. 2020, Table III: the published success count, mean, and the same ratio.
+- Huck et al. 2020, Table III: the published success count, mean, and the same ratio (only when the campaign's
+  budget is the paper's, 200: at another budget they are not comparable).
 """
 
 from __future__ import annotations
@@ -99,10 +100,16 @@ def summarize(records: list[dict[str, Any]], cells: list[str], searchers: list[s
         by.setdefault((r["cell"], r["searcher"]), []).append(r)
     paper = paper_table()
     rows = []
+
+    def published(cell: str, searcher: str) -> PaperRow | None:
+        # the paper's numbers are for its budget; at another budget they are not comparable
+        row = paper.get(cell, searcher)
+        return row if row is not None and row.budget == budget else None
+
     for cell in cells:
         base = by.get((cell, BASELINE))
         base_mean = statistics.fmean(episodes_of(r) for r in base) if base else None
-        paper_base = paper.get(cell, BASELINE)
+        paper_base = published(cell, BASELINE)
         for s in searchers:
             runs = sorted(by.get((cell, s), []), key=lambda r: r["seed"])
             if not runs:
@@ -110,7 +117,7 @@ def summarize(records: list[dict[str, Any]], cells: list[str], searchers: list[s
             eps = [float(episodes_of(r)) for r in runs]
             k = sum(bool(r["found"]) for r in runs)
             mean = statistics.fmean(eps)
-            pr = paper.get(cell, s)
+            pr = published(cell, s)
             rows.append(Row(
                 cell=cell,
                 searcher=s,
@@ -142,7 +149,7 @@ def markdown(rows: list[Row], plan: CampaignPlan) -> str:
         f"each run stopped at its first hazard; a failed run counts as {plan.budget} episodes (as in the paper). "
         "Success rate: 95 % Wilson interval. Mean: 95 % Student-t interval, clipped to "
         f"[1, {plan.budget}]. Ratio: the mean over random's mean in the same cell. "
-        f"Paper: {paper_table().citation}",
+        f"Paper (at its budget, {paper_table().budget}, only): {paper_table().citation}",
         "",
         "| cell | searcher | found | success rate (95 % CI) | mean episodes (95 % CI) | median | mean / random "
         "| paper found | paper mean | paper mean / random |",
