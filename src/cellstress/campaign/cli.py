@@ -68,7 +68,8 @@ def campaign(
                        "dropped it, the run is done again", err=True)
         if before:
             typer.echo(f"resuming: {before} of {total} runs already in {out_dir / 'runs.jsonl'}", err=True)
-        typer.echo(f"running {total - before} runs on {how.describe(total - before)}", err=True)
+        if total > before:
+            typer.echo(f"running {total - before} runs on {how.describe(total - before)}", err=True)
 
     def tick(done: int, total: int) -> None:
         state["done"] = done

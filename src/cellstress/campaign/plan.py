@@ -9,8 +9,6 @@ cellstress version); a resumed campaign must match it, or its runs would silentl
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -184,20 +182,10 @@ def manifest_difference(old: dict[str, Any], new: dict[str, Any]) -> str | None:
 
 
 def write_json_atomic(path: Path, doc: Any) -> None:
-    """Write ``doc`` as sorted, indented JSON through a temporary file and ``os.replace`` (never half a file)."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}-", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-            f.write(json.dumps(doc, sort_keys=True, indent=1, allow_nan=False) + "\n")
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
+    """Write ``doc`` as sorted, indented JSON, atomically (never half a file)."""
+    from cellstress.campaign.store import atomic_write
+
+    atomic_write(path, (json.dumps(doc, sort_keys=True, indent=1, allow_nan=False) + "\n").encode("utf-8"))
 
 
 def open_manifest(out: Path, plan: CampaignPlan) -> bool:

@@ -49,7 +49,7 @@ def read_runs(path: Path, plan: CampaignPlan) -> Loaded:
     tail = lines.pop()  # b"" when the file ends with a newline, else a line cut short by a crash
     dropped = bool(tail)
     if dropped:
-        _rewrite(path, raw[: len(raw) - len(tail)])
+        atomic_write(path, raw[: len(raw) - len(tail)])
     expected = {s.key: s for s in plan.runs()}
     records: dict[RunKey, dict[str, Any]] = {}
     for n, line in enumerate(lines, start=1):
@@ -74,7 +74,7 @@ def read_runs(path: Path, plan: CampaignPlan) -> Loaded:
     return Loaded(records, dropped)
 
 
-def _rewrite(path: Path, data: bytes) -> None:
+def atomic_write(path: Path, data: bytes) -> None:
     """Replace ``path`` by ``data`` atomically (a crash leaves the old or the new file, never a mix)."""
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}-", suffix=".tmp", dir=path.parent)
     try:
@@ -93,7 +93,7 @@ def _rewrite(path: Path, data: bytes) -> None:
 
 def rewrite_text(path: Path, text: str) -> None:
     """Write a whole text file atomically."""
-    _rewrite(path, text.encode("utf-8"))
+    atomic_write(path, text.encode("utf-8"))
 
 
 class RunWriter:
