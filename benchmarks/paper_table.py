@@ -2,7 +2,7 @@
 
 Usage: python benchmarks/paper_table.py [--seeds 10] [--budget 200]
 Prints success counts and mean episodes to the first hazard (a failed run counts as the budget), next to the
-paper's numbers. (The parallel, resumable campaign runner is a separate issue.)
+paper's numbers. Superseded by ``cellstress campaign`` (parallel, resumable, with intervals; docs/results.md).
 """
 
 from __future__ import annotations

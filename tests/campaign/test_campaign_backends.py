@@ -96,3 +96,17 @@ def test_new_searchers_plug_in_without_campaign_changes(monkeypatch):
     assert plan.searchers[0].params_dict == {"chunk": 8}
     rec = execute(plan.runs()[0])
     assert (rec["searcher"], rec["params"], rec["episodes"]) == ("lazy-random", {"chunk": 8}, 5)
+
+
+def test_a_worker_process_uses_one_numba_thread():
+    """N workers on N cores must not each start a thread per core."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    import numba
+
+    from cellstress.campaign.worker import init_worker
+
+    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"), initializer=init_worker,
+                             initargs=(1,)) as pool:
+        assert pool.submit(numba.get_num_threads).result() == 1
