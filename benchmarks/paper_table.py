@@ -30,7 +30,7 @@ def main() -> None:
     ap.add_argument("--budget", type=int, default=200)
     args = ap.parse_args()
     t0 = time.perf_counter()
-    print(f"| searcher | cell | found | mean episodes | paper found | paper mean |")
+    print("| searcher | cell | found | mean episodes | paper found | paper mean |")
     print("|---|---|---|---|---|---|")
     for ci, cell in enumerate(CELLS):
         sim = Simulator(cell)
