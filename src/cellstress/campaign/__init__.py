@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from cellstress.campaign.backends import BACKENDS, Backend
 from cellstress.campaign.plan import (
@@ -22,6 +23,9 @@ from cellstress.campaign.plan import (
     CampaignPlan,
     resolve,
 )
+
+if TYPE_CHECKING:  # table imports scipy: only when a table is written
+    from cellstress.campaign.table import Row
 
 __all__ = ["BACKENDS", "DEFAULT_BUDGET", "DEFAULT_CELLS", "DEFAULT_SEARCHERS", "DEFAULT_SEEDS", "Backend",
            "CampaignError", "CampaignPlan", "Outcome", "resolve", "run_campaign"]
@@ -35,7 +39,7 @@ class Outcome:
     done_before: int
     ran: int
     dropped_partial: bool
-    rows: tuple  # tuple[table.Row, ...]
+    rows: tuple[Row, ...]
     resumed: bool
 
 
