@@ -61,11 +61,16 @@ def topview_figure(view: EpisodeView, size: D.FigureSize = StillOptions().topvie
     ax.plot(xy[:, 0], xy[:, 1], color=D.PATH, lw=1.6, zorder=9)
     ax.plot(xy[:, 0], xy[:, 1], ".", color=D.PATH, ms=3, zorder=9)
     handles.append(Line2D([], [], color=D.PATH, lw=1.6, marker=".", ms=3, label=f"worker's path ({view.dt:g} s steps)"))
+    placed: dict[tuple[int, int], int] = {}
     for k, act in enumerate(view.actions):
         r = recs[view.action_rows(k)[-1]]
         D.draw_pose_arrow(ax, r["x"], r["y"], np.deg2rad(r["heading_deg"]), "white", size=0.16, zorder=10)
+        # actions ending at the same spot (turning in place, blocked) get their labels stacked, not overprinted
+        spot = (round(r["x"] / 0.1), round(r["y"] / 0.1))
+        above = placed.get(spot, 0)
+        placed[spot] = above + 1
         ax.annotate(f"{k + 1}{POSTURE_MARK.get(act.partition('+')[2], '?')}", (r["x"], r["y"]),
-                    xytext=(5, 5), textcoords="offset points", fontsize=7, color="#0b3c6b", zorder=11)
+                    xytext=(6, 4 + 8 * above), textcoords="offset points", fontsize=7, color="#0b3c6b", zorder=11)
     handles.append(Line2D([], [], marker=">", color="white", mec="black", ls="none", ms=7,
                           label="after action k: heading, posture\n(U upright, F forward, L / R left / right)"))
     pose = view.pose(key)
@@ -97,6 +102,12 @@ def topview_figure(view: EpisodeView, size: D.FigureSize = StillOptions().topvie
     ax.set_title(title or f"{spec.name}: {what} (episode {view.episode}), top view", fontsize=11, loc="left")
     _legend(fig, ax, handles)
     return fig, ax
+
+
+def _point_segment_2d(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    d = b - a
+    t = float(np.clip(np.dot(p - a, d) / max(float(np.dot(d, d)), 1e-12), 0.0, 1.0))
+    return float(np.linalg.norm(p - (a + t * d)))
 
 
 def _side_axis(view: EpisodeView) -> int:
@@ -160,14 +171,19 @@ def contact_figure(view: EpisodeView, size: D.FigureSize = StillOptions().contac
     t_hi = max(float(np.max(np.asarray(p)[:, u])) for p in spec.table.polygons)
     ax_side.add_patch(Rectangle((t_lo, 0.0), t_hi - t_lo, spec.table.height, facecolor=D.TABLE, edgecolor=D.TABLE_EDGE,
                                 alpha=0.6, zorder=1))
+    # fence panels near the worker: one seen edge-on is a solid line; one running along the view is drawn as a
+    # faint outline only (it stands in front of or behind the scene, not between its parts)
+    hip = pose.a[2, :2]
     for f in spec.fences:
         for a, b in zip(f.points, f.points[1:], strict=False):
+            if _point_segment_2d(hip, np.asarray(a, float), np.asarray(b, float)) > 1.2:
+                continue
             u0, u1 = sorted((a[u], b[u]))
-            if u1 - u0 < 0.02:  # a panel seen edge-on: a line
-                ax_side.plot([u0, u0], [f.bottom, f.top], color=D.FENCE, lw=2.0, alpha=0.35, zorder=2)
+            if u1 - u0 < 0.02:
+                ax_side.plot([u0, u0], [f.bottom, f.top], color=D.FENCE, lw=3.0, alpha=0.6, zorder=2)
             else:
                 ax_side.add_patch(Rectangle((u0, f.bottom), u1 - u0, f.top - f.bottom, facecolor="none",
-                                            edgecolor=D.FENCE, alpha=0.35, hatch="//", lw=0.8, zorder=2))
+                                            edgecolor=D.FENCE, alpha=0.3, ls=":", lw=1.0, zorder=2))
     ax_side.axhline(0.0, color="#777777", lw=1.0, zorder=1)
     ax_side.set_xlim(lo[u], hi[u])
     ax_side.set_ylim(0.0, max(hi[2], 2.1))
@@ -184,9 +200,10 @@ def contact_figure(view: EpisodeView, size: D.FigureSize = StillOptions().contac
                Patch(facecolor=D.BODY, alpha=0.75, label="worker's body capsules"),
                Patch(facecolor=D.REACH, alpha=0.3, edgecolor=D.REACH, label="reach volume (touching arm)"),
                Line2D([], [], color=D.REACH, ls="--", label="other arm's reach / shoulder to contact"),
+               Line2D([], [], color=D.FENCE, lw=3.0, alpha=0.6, label="fence (side view: edge-on)"),
                Line2D([], [], color="black", lw=2, marker="o", ms=4,
                       label=f"closest points, d_HR = {hit['d_HR']:.3f} m")]
-    fig.legend(handles=handles, loc="lower center", ncol=6, fontsize=7.5, frameon=False)
+    fig.legend(handles=handles, loc="lower center", ncol=7, fontsize=7, frameon=False)
     fig.suptitle(f"{spec.name}: {hit['robot_link']} / {hit['body_part']} at t = {hit['t']:.2f} s, "
                  f"v_R = {hit['v_R']:.2f} m/s, {hit['stop_phase']}", fontsize=11, x=0.06, ha="left", y=0.98)
     return fig
