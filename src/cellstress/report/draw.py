@@ -131,7 +131,7 @@ class PlanStyle:
     swept_area: bool = True
     robot_now: bool = True  # the robot at t = 0 (or at the step given to draw_plan)
     start: bool = True
-    labels: bool = True
+    start_size: float = 0.25  # m, the start marker's length
 
 
 def swept_footprint(layout: Layout):
@@ -191,7 +191,7 @@ def draw_plan(ax, layout: Layout, style: PlanStyle = PlanStyle(), robot_tau: flo
         handles.append(Patch(facecolor=ROBOT, alpha=0.55, label=f"robot links {when} (top view)"))
     if style.start:
         s = spec.human.start
-        draw_pose_arrow(ax, s.xy[0], s.xy[1], np.deg2rad(s.heading_deg), START, size=0.25, zorder=8)
+        draw_pose_arrow(ax, s.xy[0], s.xy[1], np.deg2rad(s.heading_deg), START, size=style.start_size, zorder=8)
         handles.append(Line2D([], [], marker=">", ms=9, color=START, ls="none", label="worker start and heading"))
     ax.set_aspect("equal")
     ax.set_xlim(fl.xmin - 0.1, fl.xmax + 0.1)

@@ -48,59 +48,89 @@ def layout_figure(layout: Layout, size: D.FigureSize = StillOptions().layout, ti
     return fig, ax
 
 
-def topview_figure(view: EpisodeView, size: D.FigureSize = StillOptions().topview, title: str | None = None,
-                   zone=None):
-    """The cell to scale with the worker's path, a heading and posture mark per action, the robot, body and
-    reach volume at the key step, the point of detection and the contact point. Returns (figure, axes)."""
-    fig = D.new_figure(size)
-    ax = fig.add_axes(PLAN_AXES)
-    key = view.key_row
-    handles = D.draw_plan(ax, view.layout, robot_tau=float(view.taus[key]), zone=zone)
+def _draw_episode(ax, view: EpisodeView, pose, reach: list[np.ndarray], handles: list | None,
+                  mark_size: float) -> None:
+    """The episode over a drawn plan: path, a heading and posture mark per action, body and reach volumes at the
+    key step, the first detection and the contact marker. Appends legend handles when ``handles`` is a list."""
+    add = handles.append if handles is not None else (lambda _h: None)
     recs = view.records
+    key = view.key_row
+    hit = recs[key]
     xy = np.array([[r["x"], r["y"]] for r in recs])
     ax.plot(xy[:, 0], xy[:, 1], color=D.PATH, lw=1.6, zorder=9)
     ax.plot(xy[:, 0], xy[:, 1], ".", color=D.PATH, ms=3, zorder=9)
-    handles.append(Line2D([], [], color=D.PATH, lw=1.6, marker=".", ms=3, label=f"worker's path ({view.dt:g} s steps)"))
+    add(Line2D([], [], color=D.PATH, lw=1.6, marker=".", ms=3, label=f"worker's path ({view.dt:g} s steps)"))
     placed: dict[tuple[int, int], int] = {}
     for k, act in enumerate(view.actions):
         r = recs[view.action_rows(k)[-1]]
-        D.draw_pose_arrow(ax, r["x"], r["y"], np.deg2rad(r["heading_deg"]), "white", size=0.16, zorder=10)
+        D.draw_pose_arrow(ax, r["x"], r["y"], np.deg2rad(r["heading_deg"]), "white", size=mark_size, zorder=13)
         # actions ending at the same spot (turning in place, blocked) get their labels stacked, not overprinted
         spot = (round(r["x"] / 0.1), round(r["y"] / 0.1))
         above = placed.get(spot, 0)
         placed[spot] = above + 1
         ax.annotate(f"{k + 1}{POSTURE_MARK.get(act.partition('+')[2], '?')}", (r["x"], r["y"]),
-                    xytext=(6, 4 + 8 * above), textcoords="offset points", fontsize=7, color="#0b3c6b", zorder=11)
-    handles.append(Line2D([], [], marker=">", color="white", mec="black", ls="none", ms=7,
-                          label="after action k: heading, posture\n(U upright, F forward, L / R left / right)"))
-    pose = view.pose(key)
-    body = D.capsule_patches(pose.a[:, :2], pose.b[:, :2], pose.r, facecolor=D.BODY, alpha=0.7, edgecolor="white",
-                             lw=0.4, zorder=12)
-    ax.add_collection(body)
-    handles.append(Patch(facecolor=D.BODY, alpha=0.7, label="worker's body at " + ("contact" if view.unsafe
-                                                                                     else "the closest call")))
-    hit = recs[key]
+                    xytext=(6, 4 + 8 * above), textcoords="offset points", fontsize=7, color="#0b3c6b", zorder=14)
+    add(Line2D([], [], marker=">", color="white", mec="black", ls="none", ms=7,
+               label="after action k: heading, posture\n(U upright, F forward, L / R left / right)"))
+    ax.add_collection(D.capsule_patches(pose.a[:, :2], pose.b[:, :2], pose.r, facecolor=D.BODY, alpha=0.7,
+                                        edgecolor="white", lw=0.4, zorder=12))
+    add(Patch(facecolor=D.BODY, alpha=0.7, label="worker's body at " + ("contact" if view.unsafe
+                                                                          else "the closest call")))
     for side in (0, 1):
-        pts = view.reach(key, side, REACH_STRIDE_STILL, pose)
         main = hit["body_part"] == ("left-reach", "right-reach")[side]
-        D.draw_volume(ax, pts[:, :2], view.layout.reach.spacing, D.REACH, alpha=0.25 if main else 0.0,
+        D.draw_volume(ax, reach[side][:, :2], view.layout.reach.spacing, D.REACH, alpha=0.25 if main else 0.0,
                       lw=1.2 if main else 0.8, zorder=11, fill=main, ls="-" if main else "--")
-    handles.append(Patch(facecolor=D.REACH, alpha=0.35, edgecolor=D.REACH, label="arm reach volume (projected)"))
+    add(Patch(facecolor=D.REACH, alpha=0.35, edgecolor=D.REACH, label="arm reach volume (projected)"))
     det = view.detection_row
     if det is not None:
         r = recs[det]
         ax.plot([r["x"]], [r["y"]], marker="D", ms=8, color=D.DETECT, mec="black", zorder=13, ls="none")
-        handles.append(Line2D([], [], marker="D", ms=8, color=D.DETECT, mec="black", ls="none",
-                              label=f"first detected (t = {r['t']:.2f} s, {', '.join(r['devices'])})"))
+        add(Line2D([], [], marker="D", ms=8, color=D.DETECT, mec="black", ls="none",
+                   label=f"first detected (t = {r['t']:.2f} s, {', '.join(r['devices'])})"))
     cx, cy, _ = hit["robot_point"]
     label = "contact point" if view.unsafe else "closest point (no contact)"
     ax.plot([cx], [cy], marker="*", ms=18, color=D.CONTACT, mec="black", mew=0.8, zorder=20, ls="none")
-    handles.append(Line2D([], [], marker="*", ms=14, color=D.CONTACT, mec="black", ls="none",
-                          label=f"{label} (t = {hit['t']:.2f} s)"))
+    add(Line2D([], [], marker="*", ms=14, color=D.CONTACT, mec="black", ls="none",
+               label=f"{label} (t = {hit['t']:.2f} s)"))
+
+
+INSET_AXES = (0.66, 0.07, 0.32, 0.42)  # below the legend
+
+
+def topview_figure(view: EpisodeView, size: D.FigureSize = StillOptions().topview, title: str | None = None,
+                   zone=None):
+    """The cell to scale with the worker's path, a heading and posture mark per action, the robot, body and
+    reach volume at the key step, the point of detection and the contact point, and an enlarged view of where
+    it happens below the legend. Returns (figure, main axes)."""
+    fig = D.new_figure(size)
+    ax = fig.add_axes(PLAN_AXES)
+    key = view.key_row
+    zone = zone if zone is not None else D.swept_footprint(view.layout)
+    pose = view.pose(key)
+    reach = [view.reach(key, side, REACH_STRIDE_STILL, pose) for side in (0, 1)]
+    handles = D.draw_plan(ax, view.layout, robot_tau=float(view.taus[key]), zone=zone)
+    _draw_episode(ax, view, pose, reach, handles, mark_size=0.16)
     spec = view.layout.cell.spec
     what = "hazard" if view.unsafe else "no hazard; riskiest episode"
     ax.set_title(title or f"{spec.name}: {what} (episode {view.episode}), top view", fontsize=11, loc="left")
     _legend(fig, ax, handles)
+    # the enlarged view: the path, the touching reach volume and the contact, with a margin
+    inset = fig.add_axes(INSET_AXES)
+    D.draw_plan(inset, view.layout, D.PlanStyle(start_size=0.12), robot_tau=float(view.taus[key]), zone=zone)
+    _draw_episode(inset, view, pose, reach, None, mark_size=0.08)
+    recs = view.records
+    hit = recs[key]
+    pts = [np.array([[r["x"], r["y"]] for r in recs]), np.asarray(hit["robot_point"][:2])[None]]
+    lo = np.min(np.concatenate(pts), axis=0) - 0.45
+    hi = np.max(np.concatenate(pts), axis=0) + 0.45
+    half = 0.5 * max(hi - lo)  # square, so the equal aspect fills the box
+    mid = 0.5 * (lo + hi)
+    inset.set_xlim(mid[0] - half, mid[0] + half)
+    inset.set_ylim(mid[1] - half, mid[1] + half)
+    inset.set_title("enlarged", fontsize=9, loc="left")
+    inset.tick_params(labelsize=7)
+    inset.set_xlabel("")
+    inset.set_ylabel("")
     return fig, ax
 
 
