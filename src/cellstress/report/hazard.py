@@ -173,8 +173,8 @@ def contact_figure(view: EpisodeView, size: D.FigureSize = StillOptions().contac
     allp = np.concatenate(pts)
     lo, hi = allp.min(axis=0) - 0.25, allp.max(axis=0) + 0.25
 
-    ax_top = fig.add_axes((0.06, 0.1, 0.42, 0.8))
-    ax_side = fig.add_axes((0.55, 0.1, 0.42, 0.8))
+    ax_top = fig.add_axes((0.06, 0.17, 0.42, 0.73))
+    ax_side = fig.add_axes((0.55, 0.17, 0.42, 0.73))
     D.draw_plan(ax_top, view.layout, D.PlanStyle(swept_area=False, robot_now=False, start=False))
     spec = view.layout.cell.spec
     for ax, (i, j) in ((ax_top, (0, 1)), (ax_side, (u, 2))):
@@ -233,7 +233,7 @@ def contact_figure(view: EpisodeView, size: D.FigureSize = StillOptions().contac
                Line2D([], [], color=D.FENCE, lw=3.0, alpha=0.6, label="fence (side view: edge-on)"),
                Line2D([], [], color="black", lw=2, marker="o", ms=4,
                       label=f"closest points, d_HR = {hit['d_HR']:.3f} m")]
-    fig.legend(handles=handles, loc="lower center", ncol=7, fontsize=7, frameon=False)
+    fig.legend(handles=handles, loc="lower center", ncol=4, fontsize=8, frameon=False)
     fig.suptitle(f"{spec.name}: {hit['robot_link']} / {hit['body_part']} at t = {hit['t']:.2f} s, "
                  f"v_R = {hit['v_R']:.2f} m/s, {hit['stop_phase']}", fontsize=11, x=0.06, ha="left", y=0.98)
     return fig
@@ -252,6 +252,9 @@ def risk_figure(risks: list[float], hazard_episode: int | None, size: D.FigureSi
                 label="best so far")
     if hazard_episode is not None:
         ax.axvline(hazard_episode, color="black", ls="--", lw=1.0, label=f"first hazard (episode {hazard_episode})")
+        if 1 <= hazard_episode <= len(r):
+            ax.plot([hazard_episode], [r[hazard_episode - 1]], marker="*", ms=12, color=D.CONTACT, mec="black",
+                    ls="none", label="the hazardous episode's risk")
     ax.set_xlabel("episode")
     ax.set_ylabel("risk 1/c_S = exp(v_R) / (d_HR² + 1)")
     ax.set_xlim(0.5, max(len(r), 1) + 0.5)
