@@ -24,16 +24,20 @@ def test_report_command(s3_report, tmp_path, capsys):
     assert code == 0, err
     lines = out.splitlines()
     assert lines[0] == f"report    {tmp_path / 'report.html'}"
-    assert lines[2].startswith("hazard    The worker ")
+    assert lines[2].startswith("account   The worker ")
     for name in ("topview.png", "contact.png", "replay.gif", "risk.png", "report.html"):
         assert (tmp_path / name).read_bytes() == (s3_report / name).read_bytes()
     assert _run(["report", str(tmp_path)], capsys)[0] == 0  # the folder works too
 
 
-@pytest.mark.parametrize("bad", ["missing/result.json", "notjson", "foreign"])
-def test_report_bad_input_is_one_line(bad, tmp_path, capsys):
+@pytest.mark.parametrize("bad", ["missing/result.json", "notjson", "foreign", "lost-cell"])
+def test_report_bad_input_is_one_line(bad, s3_report, tmp_path, capsys):
     (tmp_path / "notjson").write_text("{ not json")
     (tmp_path / "foreign").write_text(json.dumps({"hello": 1}))
+    doc = json.loads((s3_report / "result.json").read_text())
+    doc["cell"] = {**doc["cell"], "source": str(tmp_path / "gone.yaml"), "sha256": "0" * 64}
+    (tmp_path / "lost-cell").mkdir()
+    (tmp_path / "lost-cell" / "result.json").write_text(json.dumps(doc))
     code, out, err = _run(["report", str(tmp_path / bad)], capsys)
     assert code == 2
     assert err.startswith("error: ") and err.count("\n") == 1 and "Traceback" not in err

@@ -38,8 +38,7 @@ def report(
     folder = files.html.parent
     typer.echo(f"report    {files.html}")
     typer.echo(f"          {', '.join(p.name for p in files.paths[:-1])} in {folder}")
-    typer.echo(f"{'hazard' if files.found else 'no hazard'}{' ' * (10 - len('hazard' if files.found else 'no hazard'))}"
-               f"{files.account.headline}")
+    typer.echo(f"account   {files.account.headline}")
     if files.cell_changed:
         typer.echo("warning   the cell file has changed since the search; the pictures show the current cell")
 

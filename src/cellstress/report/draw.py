@@ -142,8 +142,9 @@ def swept_footprint(layout: Layout):
 
 
 def draw_plan(ax, layout: Layout, style: PlanStyle = PlanStyle(), robot_tau: float | None = None,
-              zone=None) -> list:
-    """Draw the cell to scale in metres; returns legend handles (one per kind of thing shown)."""
+              zone=None, robot_when: str = "at contact") -> list:
+    """Draw the cell to scale in metres; returns legend handles (one per kind of thing shown). The robot is
+    drawn at path time ``robot_tau`` (labelled ``robot_when``), or at t = 0 without one."""
     from cellstress.sim import kernels as K
     from cellstress.sim import scene
 
@@ -187,7 +188,7 @@ def draw_plan(ax, layout: Layout, style: PlanStyle = PlanStyle(), robot_tau: flo
         a, b = scene.robot_capsules(layout, tau)
         ax.add_collection(capsule_patches(a[:, :2], b[:, :2], layout.params.cap_r, facecolor=ROBOT, alpha=0.55,
                                           edgecolor="white", lw=0.5, zorder=6))
-        when = "at t = 0" if robot_tau is None else "at contact"
+        when = "at t = 0" if robot_tau is None else robot_when
         handles.append(Patch(facecolor=ROBOT, alpha=0.55, label=f"robot links {when} (top view)"))
     if style.start:
         s = spec.human.start

@@ -108,7 +108,8 @@ def topview_figure(view: EpisodeView, size: D.FigureSize = StillOptions().topvie
     zone = zone if zone is not None else D.swept_footprint(view.layout)
     pose = view.pose(key)
     reach = [view.reach(key, side, REACH_STRIDE_STILL, pose) for side in (0, 1)]
-    handles = D.draw_plan(ax, view.layout, robot_tau=float(view.taus[key]), zone=zone)
+    handles = D.draw_plan(ax, view.layout, robot_tau=float(view.taus[key]), zone=zone,
+                          robot_when="at contact" if view.unsafe else "at the closest call")
     _draw_episode(ax, view, pose, reach, handles, mark_size=0.16)
     spec = view.layout.cell.spec
     what = "hazard" if view.unsafe else "no hazard; riskiest episode"
