@@ -131,8 +131,9 @@ def account(view: EpisodeView, episodes: int | None = None) -> Account:
     if view.unsafe:
         details.append(f"At t = {hit['t']:.2f} s (step {hit['step']}) the robot's {link} is "
                        f"{_PARTS.get(part, part)} at ({px:.2f}, {py:.2f}, {pz:.2f}) m, while the robot moves at "
-                       f"v_R = {hit['v_R']:.2f} m/s: {phase_text}. The stop is not complete: this is an unsafe "
-                       f"contact.")
+                       f"v_R = {hit['v_R']:.2f} m/s: {phase_text}. "
+                       + ("No stop was requested" if phase == "running" else "The stop is not complete")
+                       + ": this is an unsafe contact.")
         headline = (f"The worker {moves}; it {seen_by}the robot's {link.split(' (')[0]} is "
                     f"{_PARTS.get(part, part).replace('touches', 'touching')}, moving at {hit['v_R']:.2f} m/s; "
                     f"{'the stop is not complete' if phase != 'running' else 'no stop was requested'}.")
