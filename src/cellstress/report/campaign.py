@@ -87,7 +87,7 @@ def discovery_figure(curves: dict[str, dict[str, np.ndarray]], counts: dict[tupl
     left, right, gap = 0.6 / size.width, 0.15 / size.width, 0.45 / size.width
     w = (1.0 - left - right - gap * (n - 1)) / n
     for k, cell in enumerate(cells):
-        ax = fig.add_axes((left + k * (w + gap), 0.24, w, 0.66))
+        ax = fig.add_axes((left + k * (w + gap), 0.14, w, 0.78))
         for s in searchers:
             if s not in curves[cell]:
                 continue
@@ -102,7 +102,7 @@ def discovery_figure(curves: dict[str, dict[str, np.ndarray]], counts: dict[tupl
         if k == 0:
             ax.set_ylabel("share of runs that found the hazard")
         ax.grid(True, color="#dddddd", lw=0.5)
-        ax.legend(fontsize=7, loc="upper left")
+        ax.legend(fontsize=7, loc="lower right")
     return fig
 
 
