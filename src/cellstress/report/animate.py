@@ -2,8 +2,8 @@
 
 Each frame shows the part of the cell the episode happens in (top view): the robot links and the worker's body
 and reach volumes at that step, the closest points joined by a line, and beside it the time, d_HR, v_R, what
-each safety device sees and the robot's stop phase. The static cell is drawn once; only the moving things
-are redrawn per frame.
+each safety device sees and the robot's stop phase. The static cell is rendered once; each frame restores that
+image and draws the moving things over it (so they lie above every static thing, whatever its zorder).
 """
 
 from __future__ import annotations
@@ -65,6 +65,10 @@ def render_frames(view: EpisodeView, options: AnimationOptions = AnimationOption
     path = np.array([[r["x"], r["y"]] for r in recs])
     tripped: dict[str, float] = {}
     frames = []
+    # blitting: the static cell is rendered once; each frame restores it and draws only the moving artists
+    canvas = fig.canvas
+    canvas.draw()
+    background = canvas.copy_from_bbox(fig.bbox)
     n_steps = len(recs) - 1
     for i, r in enumerate(recs):
         artists = []
@@ -116,7 +120,10 @@ def render_frames(view: EpisodeView, options: AnimationOptions = AnimationOption
         for k, (text, color) in enumerate(lines):
             artists.append(panel.text(0.0, 1.0 - k * 0.055, text, color=color, fontsize=8.5, va="top",
                                       family="monospace", transform=panel.transAxes))
-        frames.append(D.render_rgb(fig))
+        canvas.restore_region(background)
+        for a in sorted(artists, key=lambda a: a.get_zorder()):  # stable: equal zorders keep their order
+            a.axes.draw_artist(a)
+        frames.append(np.asarray(canvas.buffer_rgba())[:, :, :3].copy())
         for a in artists:
             a.remove()
     return frames

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.collections import PatchCollection
+from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon, Rectangle
@@ -75,22 +75,29 @@ def render_rgb(fig: Figure) -> np.ndarray:
 
 
 # ---- shapes -----------------------------------------------------------------------------------------------
-def stadium(a: np.ndarray, b: np.ndarray, r: float, n: int = 10) -> np.ndarray:
-    """Outline (m, 2) of the 2-D segment a-b inflated by r: a capsule seen from the side."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
+def stadiums(a: np.ndarray, b: np.ndarray, r: np.ndarray, n: int = 10) -> np.ndarray:
+    """Outlines (m, 2n, 2) of the 2-D segments a-b (each (m, 2)) inflated by r: capsules seen from the side.
+    Vectorised: the robot's swept area alone is a few thousand of them."""
+    a, b = np.atleast_2d(np.asarray(a, float)), np.atleast_2d(np.asarray(b, float))
+    r = np.broadcast_to(np.asarray(r, float), (len(a),))
     d = b - a
-    length = float(np.hypot(d[0], d[1]))
-    ang = float(np.arctan2(d[1], d[0])) if length > 1e-9 else 0.0
+    ang = np.where(np.hypot(d[:, 0], d[:, 1]) > 1e-9, np.arctan2(d[:, 1], d[:, 0]), 0.0)
     arc = np.linspace(-np.pi / 2, np.pi / 2, n)
-    end_b = b + r * np.stack([np.cos(ang + arc), np.sin(ang + arc)], axis=1)
-    end_a = a + r * np.stack([np.cos(ang + np.pi + arc), np.sin(ang + np.pi + arc)], axis=1)
-    return np.concatenate([end_b, end_a])
+    th_b = ang[:, None] + arc[None, :]
+    th_a = th_b + np.pi
+    end_b = b[:, None, :] + r[:, None, None] * np.stack([np.cos(th_b), np.sin(th_b)], axis=2)
+    end_a = a[:, None, :] + r[:, None, None] * np.stack([np.cos(th_a), np.sin(th_a)], axis=2)
+    return np.concatenate([end_b, end_a], axis=1)
 
 
-def capsule_patches(a2: np.ndarray, b2: np.ndarray, radii: np.ndarray, **style) -> PatchCollection:
+def stadium(a: np.ndarray, b: np.ndarray, r: float, n: int = 10) -> np.ndarray:
+    """Outline (2n, 2) of one segment a-b inflated by r."""
+    return stadiums(np.asarray(a, float)[None], np.asarray(b, float)[None], np.asarray([r], float), n)[0]
+
+
+def capsule_patches(a2: np.ndarray, b2: np.ndarray, radii: np.ndarray, **style) -> PolyCollection:
     """Projected capsules (axes a2, b2 of shape (n, 2)) as one collection of stadiums."""
-    polys = [Polygon(stadium(a2[i], b2[i], float(radii[i])), closed=True) for i in range(len(radii))]
-    return PatchCollection(polys, match_original=False, **style)
+    return PolyCollection(stadiums(a2, b2, radii), closed=True, **style)
 
 
 def occupancy(points2d: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:

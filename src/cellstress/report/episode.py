@@ -73,7 +73,14 @@ class EpisodeView:
         return scene.robot_capsules(self.layout, float(self.taus[i]))
 
     def reach(self, i: int, side: int, stride: int = 1, pose: scene.BodyPose | None = None) -> np.ndarray:
-        return scene.reach_points(self.layout, pose if pose is not None else self.pose(i), side, stride)
+        nodes = self._nodes.get(stride)
+        if nodes is None:  # the same nodes serve every step: computed once per episode
+            nodes = self._nodes[stride] = scene.reach_nodes(self.layout, stride)
+        return scene.reach_points(self.layout, pose if pose is not None else self.pose(i), side, stride, nodes)
+
+    @cached_property
+    def _nodes(self) -> dict[int, np.ndarray]:
+        return {}
 
     @property
     def capsule_radii(self) -> np.ndarray:

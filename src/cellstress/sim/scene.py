@@ -63,17 +63,23 @@ def _detour_within(fences, near, n_near, s, pts, arm_length, keep):
         keep[i] = d - arm_length <= 0.0
 
 
-def reach_points(layout: Layout, pose: BodyPose, side: int, stride: int = 1) -> np.ndarray:
-    """World points (m, 3) of the reach-field grid nodes inside arm ``side``'s reach volume (0 left, 1 right).
-
-    A node is inside where the kernel's ``reach_value`` is <= 0: the field value at the node (trilinear
-    interpolation is exact at nodes) and, near fences, the arm's detour around them within the arm's length.
-    ``stride`` > 1 keeps every stride-th node per axis (coarser, faster)."""
-    P = layout.params
+def reach_nodes(layout: Layout, stride: int = 1) -> np.ndarray:
+    """Shoulder-frame coordinates (m, 3) of the right arm's reach-field grid nodes inside its volume (field value
+    <= 0; trilinear interpolation is exact at nodes). ``stride`` > 1 keeps every stride-th node per axis."""
     field = layout.reach
     vals = field.values[::stride, ::stride, ::stride]
-    idx = np.argwhere(vals <= 0.0).astype(float) * stride
-    local = field.origin + idx * field.spacing
+    return field.origin + np.argwhere(vals <= 0.0).astype(float) * (stride * field.spacing)
+
+
+def reach_points(layout: Layout, pose: BodyPose, side: int, stride: int = 1,
+                 nodes: np.ndarray | None = None) -> np.ndarray:
+    """World points (m, 3) of the reach-field grid nodes inside arm ``side``'s reach volume (0 left, 1 right).
+
+    A node is inside where the kernel's ``reach_value`` is <= 0: the field value at the node and, near fences,
+    the arm's detour around them within the arm's length. ``nodes`` may hold ``reach_nodes(layout, stride)``
+    computed once, for many poses."""
+    P = layout.params
+    local = (reach_nodes(layout, stride) if nodes is None else nodes).copy()
     if side == 0:
         local[:, 1] = -local[:, 1]  # the left arm is the mirror image of the right one
     pts = pose.shoulders[side] + local @ pose.trunk.T
