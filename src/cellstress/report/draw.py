@@ -67,13 +67,6 @@ def save_png(fig: Figure, path: str | Path) -> Path:
     return path
 
 
-def render_rgb(fig: Figure) -> np.ndarray:
-    """The figure as an (h, w, 3) uint8 array."""
-    canvas = fig.canvas
-    canvas.draw()
-    return np.asarray(canvas.buffer_rgba())[:, :, :3].copy()
-
-
 # ---- shapes -----------------------------------------------------------------------------------------------
 def stadiums(a: np.ndarray, b: np.ndarray, r: np.ndarray, n: int = 10) -> np.ndarray:
     """Outlines (m, 2n, 2) of the 2-D segments a-b (each (m, 2)) inflated by r: capsules seen from the side.
