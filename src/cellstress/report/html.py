@@ -21,7 +21,8 @@ h1 { font-size: 1.6em; margin-bottom: 0.2em; } h2 { font-size: 1.25em; margin-to
 .warn { background: #fff8e1; border-left: 6px solid #f9a825; padding: 0.5em 1em; }
 table { border-collapse: collapse; margin: 0.5em 0; font-size: 0.9em; }
 th, td { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
-th { background: #f2f2f2; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
+th { background: #f2f2f2; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
 tr.unsafe td { background: #fde8e8; font-weight: bold; }
 figure { margin: 1em 0; } figcaption { color: #555; font-size: 0.9em; }
 img { max-width: 100%; height: auto; border: 1px solid #eee; }
@@ -40,10 +41,13 @@ def figure(path: str | Path, caption: str, alt: str) -> str:
             f"</figcaption></figure>")
 
 
-def table(header: list[str], rows: list[list], numeric: set[int] | None = None,
+def table(header: list[str] | None, rows: list[list], numeric: set[int] | None = None,
           row_classes: list[str] | None = None) -> str:
+    """An HTML table; ``numeric`` columns are right-aligned and never wrapped, ``header`` None has no head row."""
     numeric = numeric or set()
-    out = ["<table>", "<tr>" + "".join(f"<th>{escape(h)}</th>" for h in header) + "</tr>"]
+    out = ["<table>"]
+    if header:
+        out.append("<tr>" + "".join(f"<th>{escape(h)}</th>" for h in header) + "</tr>")
     for k, row in enumerate(rows):
         cls = f' class="{row_classes[k]}"' if row_classes and row_classes[k] else ""
         cells = "".join(f'<td class="num">{escape(str(v))}</td>' if i in numeric else f"<td>{escape(str(v))}</td>"

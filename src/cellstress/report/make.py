@@ -149,11 +149,11 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
     rows, classes = action_rows(view)
     body.append(H.table(["#", "action", "t [s]", "position at end [m]", "heading [deg]", "forward [deg]",
                          "lateral [deg]", "min d_HR [m]", "max v_R [m/s]", "seen by", "robot at end"],
-                        rows, numeric={0, 4, 5, 6, 7, 8}, row_classes=classes))
+                        rows, numeric={0, 2, 3, 4, 5, 6, 7, 8}, row_classes=classes))
     body.append("<h2>Parameters</h2>")
     params = ", ".join(f"{k} = {v}" for k, v in sorted(res.params.items()))
     spec = view.layout.cell.spec
-    body.append(H.table(["", ""], [
+    body.append(H.table(None, [
         ["cell", f"{cell} ({res.cell.get('source', '')})"],
         ["cell sha256", str(res.cell.get("sha256", ""))],
         ["searcher", f"{res.searcher} ({params})"],
