@@ -289,8 +289,11 @@ def search(
                                           "(default budget // 8).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print result.json to stdout instead of the "
                                           "summary.")] = False,
+    no_report: Annotated[bool, typer.Option("--no-report", help="Do not write the report (pictures, "
+                                            "report.html) next to result.json.")] = False,
 ) -> None:
-    """Search a cell for a sequence of worker actions that ends in an unsafe contact; write result.json."""
+    """Search a cell for a sequence of worker actions that ends in an unsafe contact; write result.json
+    and its report (see 'cellstress report')."""
     import time
 
     from cellstress.search import make_searcher
@@ -333,8 +336,15 @@ def search(
     except OSError as exc:
         raise _fail(f"--out {out}: cannot write result.json ({exc.strerror or exc})") from None
     rate = result.episodes / max(elapsed, 1e-9)
+    report = None
+    if not no_report:
+        from cellstress.report.cli import after_search
+
+        report = after_search(path, sim)
     if as_json:
         typer.echo(result.to_json(), nl=False)
+        if report:
+            typer.echo(report, err=True)
         typer.echo(f"{result.episodes} episodes in {elapsed:.2f} s ({rate:.0f} episodes/s); wrote {path}",
                    err=True)
         return
@@ -354,6 +364,8 @@ def search(
         x, y, z = h["point"]
         echo(f"contact   t={_num(h['time_s'])} s (step {h['step']}): {h['robot_link']} / {h['body_part']} at "
              f"({x:.3f}, {y:.3f}, {z:.3f}) m, robot moving at v_R {h['v_R']:.3f} m/s")
+    if report:
+        echo(report)
     echo(f"wrote     {path}")
 
 
@@ -409,6 +421,11 @@ def replay(
 from cellstress.campaign.cli import campaign  # noqa: E402
 
 app.command()(campaign)
+
+# ---- report, show: cellstress.report.cli ------------------------------------------------------------------
+from cellstress.report.cli import register as _register_report  # noqa: E402 (a light import: typer only)
+
+_register_report(app)
 
 
 # ---- entry point ------------------------------------------------------------------------------------------
