@@ -49,6 +49,19 @@ def test_two_worker_processes_give_the_same_lines(one_worker, tmp_path):
     assert _sorted_lines(tmp_path) == _sorted_lines(one_worker)
     assert (tmp_path / "table.md").read_text() == (one_worker / "table.md").read_text()
     assert (tmp_path / "table.csv").read_text() == (one_worker / "table.csv").read_text()
+    # the campaign report follows the plan's order, not the order in which runs finished
+    assert (tmp_path / "report.html").read_bytes() == (one_worker / "report.html").read_bytes()
+    assert (tmp_path / "discovery.png").read_bytes() == (one_worker / "discovery.png").read_bytes()
+
+
+def test_campaign_writes_its_report(one_worker):
+    from PIL import Image
+
+    with Image.open(one_worker / "discovery.png") as im:
+        im.load()
+        assert im.width > 300 and im.height > 200
+    html = (one_worker / "report.html").read_text(encoding="utf-8")
+    assert "s1-scanner-width" in html and "mcts-commit" in html and "data:image/png;base64," in html
 
 
 def test_ray_gives_the_same_lines(one_worker, tmp_path, ray_local):

@@ -46,7 +46,8 @@ class Outcome:
 def run_campaign(plan: CampaignPlan, out: str | Path, backend: Backend | None = None, *,
                  progress: Callable[[int, int], None] | None = None,
                  on_start: Callable[[int, int, bool], None] | None = None) -> Outcome:
-    """Run the runs of ``plan`` not yet in ``out/runs.jsonl`` and write the tables.
+    """Run the runs of ``plan`` not yet in ``out/runs.jsonl``; write the tables, ``discovery.png`` and
+    ``report.html``.
 
     ``on_start(total, done_before, dropped_partial)`` is called once the folder has been read;
     ``progress(done, total)`` after every run appended. Raises ``CampaignError`` for a folder that holds
@@ -54,7 +55,8 @@ def run_campaign(plan: CampaignPlan, out: str | Path, backend: Backend | None = 
     """
     from cellstress.campaign.plan import open_manifest
     from cellstress.campaign.store import RUNS, FolderLock, RunWriter, read_runs, record_key
-    from cellstress.campaign.table import write_tables
+    from cellstress.campaign.table import markdown, write_tables
+    from cellstress.report.campaign import write_campaign_report
 
     backend = backend or Backend()
     out = Path(out)
@@ -81,4 +83,7 @@ def run_campaign(plan: CampaignPlan, out: str | Path, backend: Backend | None = 
                 if progress is not None:
                     progress(len(records), total)
         rows = write_tables(out, list(records.values()), plan)
+        # the report in the plan's order, not the order runs finished, so it is the same for any backend
+        in_order = [records[s.key] for s in plan.runs() if s.key in records]
+        write_campaign_report(in_order, markdown(rows, plan), out)
     return Outcome(total, total - len(todo), ran, loaded.dropped_partial, tuple(rows), resumed)

@@ -13,8 +13,9 @@ INTERRUPTED = 130  # the shell's code for a program stopped by SIGINT
 
 
 def campaign(
-    out: Annotated[str, typer.Option("--out", "-o", help="Folder for campaign.json, runs.jsonl, table.md and "
-                                     "table.csv. Run the same command again to resume.")],
+    out: Annotated[str, typer.Option("--out", "-o", help="Folder for campaign.json, runs.jsonl, table.md, "
+                                     "table.csv, discovery.png and report.html. Run the same command again to "
+                                     "resume.")],
     cells: Annotated[list[str] | None, typer.Option("--cells", help="Cells (built-in names or cell files), "
                                                     "comma-separated or repeated. Default: s1-scanner-width, "
                                                     "s2-elbow-intrusion, s3-fence-gap.")] = None,
@@ -91,4 +92,5 @@ def campaign(
     elapsed = time.perf_counter() - t0
     typer.echo(markdown(list(outcome.rows), plan), nl=False)
     typer.echo(f"\n{outcome.total} runs ({outcome.ran} run now, {outcome.done_before} already done) in "
-               f"{elapsed:.1f} s; wrote {out_dir / TABLE_MD}, {out_dir / TABLE_CSV}")
+               f"{elapsed:.1f} s; wrote {out_dir / TABLE_MD}, {out_dir / TABLE_CSV}, "
+               f"{out_dir / 'discovery.png'}, {out_dir / 'report.html'}")
