@@ -132,7 +132,7 @@ class ReachField:
         """Trilinear lookup for points (m, 3) in the right shoulder frame (reference, not the hot path)."""
         from cellstress.sim.kernels import reach_lookup
 
-        return np.array([reach_lookup(self.values, self.origin, self.spacing, np.asarray(p, float)) for p in points])
+        return np.array([reach_lookup(self.values, self.origin, self.spacing, *(float(c) for c in p)) for p in points])
 
 
 def _build(lengths: tuple[float, float, float], spacing: float) -> ReachField:

@@ -101,14 +101,10 @@ class Work(NamedTuple):
     c1: np.ndarray
     c2: np.ndarray
     scratch: np.ndarray
-    v3a: np.ndarray
-    v3b: np.ndarray
     best_r: np.ndarray
     best_h: np.ndarray
     lbs: np.ndarray
     ts: np.ndarray
-    seg_a: np.ndarray
-    seg_b: np.ndarray
 
 
 @njit(cache=True, error_model="numpy")
@@ -120,8 +116,8 @@ def make_work(P):
         np.zeros((nc, 3)), np.zeros((nc, 3)),
         np.zeros((N_BODY_CAPSULES, 3)), np.zeros((N_BODY_CAPSULES, 3)), np.zeros(N_BODY_CAPSULES),
         np.zeros((2, 3)), np.zeros((3, 3)), np.zeros(P.fences.shape[0] + 1, dtype=np.int64),
-        np.zeros(3), np.zeros(3), np.zeros((4, 3)), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3),
-        np.zeros(2 * nc), np.zeros(2 * nc), np.zeros(3), np.zeros(3),
+        np.zeros(3), np.zeros(3), np.zeros((4, 3)), np.zeros(3), np.zeros(3),
+        np.zeros(2 * nc), np.zeros(2 * nc),
     )
 
 
@@ -246,7 +242,7 @@ def robot_capsules(P, rot, pos, ra, rb):
             rb[c, r] = bx
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def robot_live(P, t, t_stop, W):
     """Pose the robot at time t: capsules into W.ra/W.rb. Returns (v_R, stop phase, path time)."""
     tau, sigma, phase = path_time(P, t, t_stop)
@@ -341,14 +337,14 @@ def _grid_coord(c, origin, hi, h, n):
     return i, g - i, out2
 
 
-@njit(cache=True, error_model="numpy")
-def reach_lookup(vals, origin, h, p):
+@njit(cache=True, error_model="numpy", inline="always")
+def reach_lookup(vals, origin, h, px, py, pz):
     """Trilinear signed distance at p (shoulder frame); beyond the grid, the distance to it is added."""
     n = vals.shape[0]
     hi = origin + (n - 1) * h
-    i, fx, ex = _grid_coord(p[0], origin, hi, h, n)
-    j, fy, ey = _grid_coord(p[1], origin, hi, h, n)
-    k, fz, ez = _grid_coord(p[2], origin, hi, h, n)
+    i, fx, ex = _grid_coord(px, origin, hi, h, n)
+    j, fy, ey = _grid_coord(py, origin, hi, h, n)
+    k, fz, ez = _grid_coord(pz, origin, hi, h, n)
     c00 = vals[i, j, k] * (1 - fx) + vals[i + 1, j, k] * fx
     c10 = vals[i, j + 1, k] * (1 - fx) + vals[i + 1, j + 1, k] * fx
     c01 = vals[i, j, k + 1] * (1 - fx) + vals[i + 1, j, k + 1] * fx
@@ -422,20 +418,40 @@ def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz):
     return best
 
 
+class ReachArgs(NamedTuple):
+    """What the reach queries read, gathered once per step. (The hot loops get these few arrays and scalars
+    rather than SimParams and Work: numba reference-counts every array of a tuple passed along, and on this
+    path that bookkeeping cost more than the geometry.)"""
+
+    reach: np.ndarray
+    origin: float
+    h: float
+    arm_len: float
+    fences: np.ndarray
+    near: np.ndarray
+    sh: np.ndarray
+    tr: np.ndarray
+
+
 @njit(cache=True, error_model="numpy", inline="always")
-def reach_value(P, p, side, W, n_near, local):
+def reach_args(P, W):
+    return ReachArgs(P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], P.body[B_ARM_LEN], P.fences, W.near,
+                     W.sh, W.tr)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def reach_value(reach, origin, h, arm_len, fences, near, sh, tr, side, n_near, px, py, pz):
     """Signed distance from p to the reach volume of arm ``side`` (0 left, 1 right), fences respected."""
-    s0, s1, s2 = W.sh[side, 0], W.sh[side, 1], W.sh[side, 2]
-    dx, dy, dz = p[0] - s0, p[1] - s1, p[2] - s2
-    tr = W.tr
-    local[0] = tr[0, 0] * dx + tr[1, 0] * dy + tr[2, 0] * dz
+    s0, s1, s2 = sh[side, 0], sh[side, 1], sh[side, 2]
+    dx, dy, dz = px - s0, py - s1, pz - s2
+    l0 = tr[0, 0] * dx + tr[1, 0] * dy + tr[2, 0] * dz
     ly = tr[0, 1] * dx + tr[1, 1] * dy + tr[2, 1] * dz
-    local[1] = -ly if side == 0 else ly
-    local[2] = tr[0, 2] * dx + tr[1, 2] * dy + tr[2, 2] * dz
-    f = reach_lookup(P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], local)
+    l1 = -ly if side == 0 else ly
+    l2 = tr[0, 2] * dx + tr[1, 2] * dy + tr[2, 2] * dz
+    f = reach_lookup(reach, origin, h, l0, l1, l2)
     if n_near > 0:
-        detour = fence_detour(P.fences, W.near, n_near, s0, s1, s2, p[0], p[1], p[2])
-        g = detour - P.body[B_ARM_LEN]
+        detour = fence_detour(fences, near, n_near, s0, s1, s2, px, py, pz)
+        g = detour - arm_len
         if g > f:
             f = g
     return f
@@ -456,27 +472,24 @@ def near_fences(P, W, margin):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def reach_to_segment(P, a, b, r, side, W, n_near, bound, out_q):
+def reach_to_segment(reach, origin, h, arm_len, fences, near, sh, tr, side, n_near,
+                     ax, ay, az, bx, by, bz, r, bound, out_q):
     """min over the capsule axis ab of (reach distance - r), by sphere tracing the 1-Lipschitz field.
 
     Stops early once the rest of the segment cannot come below ``bound``. The minimum is found to within
     the field's grid spacing plus TRACE_REL_TOL of the distance. Writes the closest axis point to out_q.
     """
-    h = P.scal[C_REACH_H]
     step_cap = np.inf if n_near == 0 else 2.0 * h  # fence detours make the field jump: walk slowly there
-    L = np.sqrt((b[0] - a[0]) ** 2 + (b[1] - a[1]) ** 2 + (b[2] - a[2]) ** 2)
-    p = W.v3a
-    local = W.v3b
+    L = np.sqrt((bx - ax) ** 2 + (by - ay) ** 2 + (bz - az) ** 2)
     best = np.inf
     t = 0.0
     while True:
         tt = t / L if L > 0.0 else 0.0
-        for k in range(3):
-            p[k] = a[k] + tt * (b[k] - a[k])
-        f = reach_value(P, p, side, W, n_near, local)
+        px, py, pz = ax + tt * (bx - ax), ay + tt * (by - ay), az + tt * (bz - az)
+        f = reach_value(reach, origin, h, arm_len, fences, near, sh, tr, side, n_near, px, py, pz)
         if f < best:
             best = f
-            out_q[0], out_q[1], out_q[2] = p[0], p[1], p[2]
+            out_q[0], out_q[1], out_q[2] = px, py, pz
         if t >= L or f - (L - t) - r >= bound:
             break
         # no point within `step` can undercut min(best, bound) by more than the tolerance
@@ -601,7 +614,7 @@ def separation(P, W, n_near, row):
             px, py, pz = t * abx - sx, t * aby - sy, t * abz - sz
             lbs[2 * c + side] = np.sqrt(px * px + py * py + pz * pz) - P.cap_r[c] - L
             ts[2 * c + side] = t
-    pa, pb = W.seg_a, W.seg_b
+    A = reach_args(P, W)
     while True:
         m = -1
         lo = best
@@ -615,12 +628,13 @@ def separation(P, W, n_near, row):
         c, side = m // 2, m % 2
         r = P.cap_r[c]
         t = ts[m]
-        for k in range(3):
-            W.v3a[k] = ra[c, k] + t * (rb[c, k] - ra[c, k])
-        d = reach_value(P, W.v3a, side, W, n_near, W.v3b) - r
+        px, py, pz = ra[c, 0] + t * (rb[c, 0] - ra[c, 0]), ra[c, 1] + t * (rb[c, 1] - ra[c, 1]), \
+            ra[c, 2] + t * (rb[c, 2] - ra[c, 2])
+        d = reach_value(A.reach, A.origin, A.h, A.arm_len, A.fences, A.near, A.sh, A.tr, side, n_near,
+                        px, py, pz) - r
         if d < best:
             best, best_cap, best_part = d, c, PART_LEFT_REACH + side
-            _set_reach_hit(row, W.v3a)
+            row[M_RX], row[M_RY], row[M_RZ] = px, py, pz
         # trace only the part of the axis within reach of undercutting the best: |p - s| < best + r + L
         R = best + r + L
         abx, aby, abz = rb[c, 0] - ra[c, 0], rb[c, 1] - ra[c, 1], rb[c, 2] - ra[c, 2]
@@ -640,10 +654,11 @@ def separation(P, W, n_near, row):
         t1 = 1.0 if t1 > 1.0 else t1
         if t1 <= t0:
             continue
-        for k in range(3):
-            pa[k] = ra[c, k] + t0 * (rb[c, k] - ra[c, k])
-            pb[k] = ra[c, k] + t1 * (rb[c, k] - ra[c, k])
-        d = reach_to_segment(P, pa, pb, r, side, W, n_near, best, q)
+        d = reach_to_segment(A.reach, A.origin, A.h, A.arm_len, A.fences, A.near, A.sh, A.tr, side, n_near,
+                             ra[c, 0] + t0 * (rb[c, 0] - ra[c, 0]), ra[c, 1] + t0 * (rb[c, 1] - ra[c, 1]),
+                             ra[c, 2] + t0 * (rb[c, 2] - ra[c, 2]), ra[c, 0] + t1 * (rb[c, 0] - ra[c, 0]),
+                             ra[c, 1] + t1 * (rb[c, 1] - ra[c, 1]), ra[c, 2] + t1 * (rb[c, 2] - ra[c, 2]),
+                             r, best, q)
         if d < best:
             best, best_cap, best_part = d, c, PART_LEFT_REACH + side
             _set_reach_hit(row, q)
