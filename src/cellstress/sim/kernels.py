@@ -123,10 +123,10 @@ def make_work(P):
 
 # ---- robot ------------------------------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy", inline="always")
-def path_time(P, t, t_stop):
+def path_time(scal, t, t_stop):
     """(path time tau, time-scaling sigma = dtau/dt, stop phase) at time t for a stop effective at t_stop."""
-    T = P.scal[C_STOP_TIME]
-    tau0 = P.scal[C_PHASE0]
+    T = scal[C_STOP_TIME]
+    tau0 = scal[C_PHASE0]
     if not t_stop < np.inf:
         return tau0 + t, 1.0, PHASE_RUNNING
     if t < t_stop:
@@ -138,24 +138,24 @@ def path_time(P, t, t_stop):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def joint_trajectory(P, tau, sigma, q, qd):
+def joint_trajectory(scal, seg_start, seg_move, wp, tau, sigma, q, qd):
     """Joint positions and velocities on the cyclic minimum-jerk path at path time tau."""
-    cycle = P.scal[C_CYCLE]
-    dwell = P.scal[C_DWELL]
+    cycle = scal[C_CYCLE]
+    dwell = scal[C_DWELL]
     tc = tau - cycle * np.floor(tau / cycle)
-    nw = P.seg_start.shape[0]
+    nw = seg_start.shape[0]
     i = nw - 1
     for k in range(1, nw):
-        if tc < P.seg_start[k]:
+        if tc < seg_start[k]:
             i = k - 1
             break
     j = i + 1 if i + 1 < nw else 0
-    T = P.seg_move[i]
-    u = (tc - P.seg_start[i] - dwell) / T
+    T = seg_move[i]
+    u = (tc - seg_start[i] - dwell) / T
     nj = q.shape[0]
     if u <= 0.0:
         for k in range(nj):
-            q[k] = P.wp[i, k]
+            q[k] = wp[i, k]
             qd[k] = 0.0
         return
     if u > 1.0:
@@ -163,35 +163,35 @@ def joint_trajectory(P, tau, sigma, q, qd):
     s = u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
     ds = 30.0 * u * u * (1.0 - u) * (1.0 - u) / T * sigma
     for k in range(nj):
-        dq = P.wp[j, k] - P.wp[i, k]
-        q[k] = P.wp[i, k] + s * dq
+        dq = wp[j, k] - wp[i, k]
+        q[k] = wp[i, k] + s * dq
         qd[k] = ds * dq
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def forward_kinematics(P, q, rot, pos):
+def forward_kinematics(parents, placements, base, axes, q, rot, pos):
     """World rotation and origin of every joint frame."""
     nj = q.shape[0]
     m = np.empty((3, 3))
     for j in range(nj):
-        par = P.parents[j]
-        pl = P.placements[j]
+        par = parents[j]
+        pl = placements[j]
         # parent frame in the world
         for r in range(3):
             for c in range(3):
                 acc = 0.0
                 for k in range(3):
-                    pr = P.base[r, k] if par < 0 else rot[par, r, k]
+                    pr = base[r, k] if par < 0 else rot[par, r, k]
                     acc += pr * pl[k, c]
                 m[r, c] = acc
         for r in range(3):
-            acc = P.base[r, 3] if par < 0 else pos[par, r]
+            acc = base[r, 3] if par < 0 else pos[par, r]
             for k in range(3):
-                pr = P.base[r, k] if par < 0 else rot[par, r, k]
+                pr = base[r, k] if par < 0 else rot[par, r, k]
                 acc += pr * pl[k, 3]
             pos[j, r] = acc
         # rotation about the joint axis (Rodrigues)
-        kx, ky, kz = P.axes[j, 0], P.axes[j, 1], P.axes[j, 2]
+        kx, ky, kz = axes[j, 0], axes[j, 1], axes[j, 2]
         c, s = np.cos(q[j]), np.sin(q[j])
         v = 1.0 - c
         r00, r01, r02 = c + kx * kx * v, kx * ky * v - kz * s, kx * kz * v + ky * s
@@ -205,18 +205,18 @@ def forward_kinematics(P, q, rot, pos):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def fastest_joint_speed(P, qd, rot, pos):
+def fastest_joint_speed(anc, axes, qd, rot, pos):
     """v_R: the largest Cartesian speed of any joint origin (the paper's 'fastest robot joint')."""
     nj = qd.shape[0]
     best = 0.0
     for i in range(nj):
         vx = vy = vz = 0.0
         for j in range(i):
-            if P.anc[i, j] == 0.0:
+            if anc[i, j] == 0.0:
                 continue
-            wx = rot[j, 0, 0] * P.axes[j, 0] + rot[j, 0, 1] * P.axes[j, 1] + rot[j, 0, 2] * P.axes[j, 2]
-            wy = rot[j, 1, 0] * P.axes[j, 0] + rot[j, 1, 1] * P.axes[j, 1] + rot[j, 1, 2] * P.axes[j, 2]
-            wz = rot[j, 2, 0] * P.axes[j, 0] + rot[j, 2, 1] * P.axes[j, 1] + rot[j, 2, 2] * P.axes[j, 2]
+            wx = rot[j, 0, 0] * axes[j, 0] + rot[j, 0, 1] * axes[j, 1] + rot[j, 0, 2] * axes[j, 2]
+            wy = rot[j, 1, 0] * axes[j, 0] + rot[j, 1, 1] * axes[j, 1] + rot[j, 1, 2] * axes[j, 2]
+            wz = rot[j, 2, 0] * axes[j, 0] + rot[j, 2, 1] * axes[j, 1] + rot[j, 2, 2] * axes[j, 2]
             dx, dy, dz = pos[i, 0] - pos[j, 0], pos[i, 1] - pos[j, 1], pos[i, 2] - pos[j, 2]
             vx += qd[j] * (wy * dz - wz * dy)
             vy += qd[j] * (wz * dx - wx * dz)
@@ -228,28 +228,29 @@ def fastest_joint_speed(P, qd, rot, pos):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def robot_capsules(P, rot, pos, ra, rb):
-    for c in range(P.cap_r.shape[0]):
-        j = P.cap_joint[c]
+def robot_capsules(cap_joint, cap_a, cap_b, base, rot, pos, ra, rb):
+    for c in range(cap_joint.shape[0]):
+        j = cap_joint[c]
         for r in range(3):
-            ax = P.base[r, 3] if j < 0 else pos[j, r]
+            ax = base[r, 3] if j < 0 else pos[j, r]
             bx = ax
             for k in range(3):
-                m = P.base[r, k] if j < 0 else rot[j, r, k]
-                ax += m * P.cap_a[c, k]
-                bx += m * P.cap_b[c, k]
+                m = base[r, k] if j < 0 else rot[j, r, k]
+                ax += m * cap_a[c, k]
+                bx += m * cap_b[c, k]
             ra[c, r] = ax
             rb[c, r] = bx
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def robot_live(P, t, t_stop, W):
     """Pose the robot at time t: capsules into W.ra/W.rb. Returns (v_R, stop phase, path time)."""
-    tau, sigma, phase = path_time(P, t, t_stop)
-    joint_trajectory(P, tau, sigma, W.q, W.qd)
-    forward_kinematics(P, W.q, W.rot, W.pos)
-    robot_capsules(P, W.rot, W.pos, W.ra, W.rb)
-    return fastest_joint_speed(P, W.qd, W.rot, W.pos), phase, tau
+    tau, sigma, phase = path_time(P.scal, t, t_stop)
+    q, qd, rot, pos = W.q, W.qd, W.rot, W.pos
+    joint_trajectory(P.scal, P.seg_start, P.seg_move, P.wp, tau, sigma, q, qd)
+    forward_kinematics(P.parents, P.placements, P.base, P.axes, q, rot, pos)
+    robot_capsules(P.cap_joint, P.cap_a, P.cap_b, P.base, rot, pos, W.ra, W.rb)
+    return fastest_joint_speed(P.anc, P.axes, qd, rot, pos), phase, tau
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -257,12 +258,14 @@ def robot_at(P, k, t_stop, W):
     """The robot at step k. Until a stop takes effect every episode moves the robot identically, so those
     steps come from a table made once per cell by the same code (bit-identical to computing them)."""
     t = k * P.scal[C_DT]
-    if t < t_stop and k < P.pre_v.shape[0]:
-        for c in range(P.cap_r.shape[0]):
+    pre_v = P.pre_v
+    if t < t_stop and k < pre_v.shape[0]:
+        pre_ra, pre_rb, ra, rb = P.pre_ra, P.pre_rb, W.ra, W.rb
+        for c in range(ra.shape[0]):
             for r in range(3):
-                W.ra[c, r] = P.pre_ra[k, c, r]
-                W.rb[c, r] = P.pre_rb[k, c, r]
-        return P.pre_v[k], (PHASE_RUNNING if t_stop == np.inf else PHASE_PENDING), P.pre_tau[k]
+                ra[c, r] = pre_ra[k, c, r]
+                rb[c, r] = pre_rb[k, c, r]
+        return pre_v[k], (PHASE_RUNNING if t_stop == np.inf else PHASE_PENDING), P.pre_tau[k]
     return robot_live(P, t, t_stop, W)
 
 
@@ -277,10 +280,15 @@ def robot_table(P, n, ra, rb, v, tau):
 
 
 # ---- human ------------------------------------------------------------------------------------------------
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def human_pose(P, x, y, heading, fwd, lat, W):
     """Body capsules (W.ha, W.hb, W.hr), shoulders (W.sh) and trunk frame (W.tr, columns x, y, z)."""
-    b = P.body
+    pose_body(P.body, x, y, heading, fwd, lat, W.ha, W.hb, W.hr, W.sh, W.tr)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def pose_body(b, x, y, heading, fwd, lat, ha, hb, hr, sh, tr):
+    """human_pose on the arrays themselves (the hot path; see ReachArgs for why)."""
     ch, shh = np.cos(heading), np.sin(heading)
     cf, sf = np.cos(fwd), np.sin(fwd)
     cl, sl = np.cos(lat), np.sin(lat)
@@ -288,7 +296,6 @@ def human_pose(P, x, y, heading, fwd, lat, W):
     xb0, xb1, xb2 = cf, 0.0, -sf
     zb0, zb1, zb2 = sf * cl, sl, cf * cl
     yb0, yb1, yb2 = zb1 * xb2 - zb2 * xb1, zb2 * xb0 - zb0 * xb2, zb0 * xb1 - zb1 * xb0
-    tr = W.tr
     tr[0, 0], tr[1, 0], tr[2, 0] = xb0 * ch - xb1 * shh, xb0 * shh + xb1 * ch, xb2
     tr[0, 1], tr[1, 1], tr[2, 1] = yb0 * ch - yb1 * shh, yb0 * shh + yb1 * ch, yb2
     tr[0, 2], tr[1, 2], tr[2, 2] = zb0 * ch - zb1 * shh, zb0 * shh + zb1 * ch, zb2
@@ -297,27 +304,27 @@ def human_pose(P, x, y, heading, fwd, lat, W):
     # legs
     for k in range(2):
         sgn = 1.0 if k == 0 else -1.0
-        W.ha[k, 0], W.ha[k, 1], W.ha[k, 2] = x + sgn * b[B_LEG_HALF] * lx, y + sgn * b[B_LEG_HALF] * ly, hz
-        W.hb[k, 0], W.hb[k, 1], W.hb[k, 2] = W.ha[k, 0], W.ha[k, 1], b[B_R_LEG]
-        W.hr[k] = b[B_R_LEG]
+        ha[k, 0], ha[k, 1], ha[k, 2] = x + sgn * b[B_LEG_HALF] * lx, y + sgn * b[B_LEG_HALF] * ly, hz
+        hb[k, 0], hb[k, 1], hb[k, 2] = ha[k, 0], ha[k, 1], b[B_R_LEG]
+        hr[k] = b[B_R_LEG]
     # trunk and head
-    W.ha[2, 0], W.ha[2, 1], W.ha[2, 2] = x, y, hz
+    ha[2, 0], ha[2, 1], ha[2, 2] = x, y, hz
     for r in range(3):
-        W.hb[2, r] = W.ha[2, r] + b[B_TRUNK_TOP] * tr[r, 2]
-        W.ha[3, r] = W.ha[2, r] + b[B_HEAD_RISE] * tr[r, 2]
-        W.hb[3, r] = W.ha[3, r]
-    W.hr[2] = b[B_R_TRUNK]
-    W.hr[3] = b[B_R_HEAD]
+        hb[2, r] = ha[2, r] + b[B_TRUNK_TOP] * tr[r, 2]
+        ha[3, r] = ha[2, r] + b[B_HEAD_RISE] * tr[r, 2]
+        hb[3, r] = ha[3, r]
+    hr[2] = b[B_R_TRUNK]
+    hr[3] = b[B_R_HEAD]
     # shoulders and hanging arms (left = 0, right = 1)
     for k in range(2):
         sgn = 1.0 if k == 0 else -1.0
         for r in range(3):
-            W.sh[k, r] = W.ha[2, r] + b[B_SHOULDER_RISE] * tr[r, 2] + sgn * b[B_SHOULDER_HALF] * tr[r, 1]
-            W.ha[4 + k, r] = W.sh[k, r]
-            W.hb[4 + k, r] = W.sh[k, r]
-        low = W.sh[k, 2] - (b[B_ARM_LEN] - b[B_R_ARM])
-        W.hb[4 + k, 2] = low if low > b[B_R_ARM] else b[B_R_ARM]
-        W.hr[4 + k] = b[B_R_ARM]
+            sh[k, r] = ha[2, r] + b[B_SHOULDER_RISE] * tr[r, 2] + sgn * b[B_SHOULDER_HALF] * tr[r, 1]
+            ha[4 + k, r] = sh[k, r]
+            hb[4 + k, r] = sh[k, r]
+        low = sh[k, 2] - (b[B_ARM_LEN] - b[B_R_ARM])
+        hb[4 + k, 2] = low if low > b[B_R_ARM] else b[B_R_ARM]
+        hr[4 + k] = b[B_R_ARM]
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -457,16 +464,21 @@ def reach_value(reach, origin, h, arm_len, fences, near, sh, tr, side, n_near, p
     return f
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def near_fences(P, W, margin):
     """Collect into W.near the fence panels within ``margin`` of either shoulder (plan view)."""
+    return collect_near_fences(P.fences, W.sh, W.near, margin)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def collect_near_fences(fences, sh, near, margin):
     n = 0
-    for f in range(P.fences.shape[0]):
-        r = P.fences[f]
-        d0 = point_segment_2d(W.sh[0, 0], W.sh[0, 1], r[0], r[1], r[2], r[3])
-        d1 = point_segment_2d(W.sh[1, 0], W.sh[1, 1], r[0], r[1], r[2], r[3])
+    for f in range(fences.shape[0]):
+        r = fences[f]
+        d0 = point_segment_2d(sh[0, 0], sh[0, 1], r[0], r[1], r[2], r[3])
+        d1 = point_segment_2d(sh[1, 0], sh[1, 1], r[0], r[1], r[2], r[3])
         if d0 < margin or d1 < margin:
-            W.near[n] = f
+            near[n] = f
             n += 1
     return n
 
@@ -505,17 +517,17 @@ def reach_to_segment(reach, origin, h, arm_len, fences, near, sh, tr, side, n_ne
 
 # ---- sensing ----------------------------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy", inline="always")
-def device_sees(P, d, W, n_near):
+def device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr, c1, c2, scratch):
     """Does device d detect the worker: a body capsule (legs, trunk, head, arms at rest) in its region?
 
     The reach volumes are not seen: they stand for where an arm *could* strike, and the worst-case worker
     keeps the arm back until it can. ISO 13855's reach allowance C covers exactly this.
     """
-    if P.dev_kind[d] == DEV_SCANNER:
-        H = P.dev_rect[d, 4]
-        start, count = P.dev_poly[d, 0], P.dev_poly[d, 1]
+    if dev_kind[d] == DEV_SCANNER:
+        H = dev_rect[d, 4]
+        start, count = dev_poly[d, 0], dev_poly[d, 1]
         for c in range(N_BODY_CAPSULES):
-            a, b, r = W.ha[c], W.hb[c], W.hr[c]
+            a, b, r = ha[c], hb[c], hr[c]
             lo, hi = min(a[2], b[2]), max(a[2], b[2])
             if H < lo - r or H > hi + r:
                 continue
@@ -528,52 +540,50 @@ def device_sees(P, d, W, n_near):
             dz = abs(pz - H)
             if dz > r:
                 continue
-            if polygon_distance(px, py, P.dev_verts, start, count) <= np.sqrt(r * r - dz * dz):
+            if polygon_distance(px, py, dev_verts, start, count) <= np.sqrt(r * r - dz * dz):
                 return True
     else:
-        r = P.dev_rect[d]
+        r = dev_rect[d]
         # no body capsule is further than this from the hip axis in plan view
-        extent = P.body[B_SHOULDER_HALF] + P.body[B_R_TRUNK] + P.body[B_HEAD_RISE]
-        if point_segment_2d(W.ha[2, 0], W.ha[2, 1], r[0], r[1], r[2], r[3]) > extent:
+        extent = body[B_SHOULDER_HALF] + body[B_R_TRUNK] + body[B_HEAD_RISE]
+        if point_segment_2d(ha[2, 0], ha[2, 1], r[0], r[1], r[2], r[3]) > extent:
             return False
         for c in range(N_BODY_CAPSULES):
-            if segment_rectangle(W.ha[c], W.hb[c], r, W.c1, W.c2, W.scratch) <= W.hr[c]:
+            if segment_rectangle(ha[c], hb[c], r, c1, c2, scratch) <= hr[c]:
                 return True
     return False
 
 
 # ---- walking and posture limits ---------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy", inline="always")
-def feet_ok(P, x, y):
-    """The footprint circle stays on the floor, off the table and clear of fence panels."""
-    r = P.body[B_BODY_RADIUS]
-    fl = P.floor
+def feet_ok(r, fl, table_verts, table_poly, fences, x, y):
+    """The footprint circle (radius r) stays on the floor, off the table and clear of fence panels."""
     if x - r < fl[0] or x + r > fl[1] or y - r < fl[2] or y + r > fl[3]:
         return False
-    for t in range(P.table_poly.shape[0]):
-        if polygon_distance(x, y, P.table_verts, P.table_poly[t, 0], P.table_poly[t, 1]) < r:
+    for t in range(table_poly.shape[0]):
+        if polygon_distance(x, y, table_verts, table_poly[t, 0], table_poly[t, 1]) < r:
             return False
-    for f in range(P.fences.shape[0]):
-        fe = P.fences[f]
+    for f in range(fences.shape[0]):
+        fe = fences[f]
         if fe[4] < WALK_BLOCK_HEIGHT and point_segment_2d(x, y, fe[0], fe[1], fe[2], fe[3]) < r:
             return False
     return True
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def trunk_clear(P, W):
+def trunk_clear(body, fences, ha, hb, hr, c1, c2, scratch):
     """Trunk, head and arms (from the shoulders down) do not pass through any fence panel.
 
     The shoulders matter most: the reach volumes hang on them, so a shoulder past a panel would reach
     around it for free. (Where the hands can get past a panel is limited separately, by fence_detour.)
     """
-    extent = P.body[B_HEAD_RISE] + P.body[B_R_HEAD] + P.body[B_SHOULDER_HALF]
-    for f in range(P.fences.shape[0]):
-        fe = P.fences[f]
-        if point_segment_2d(W.ha[2, 0], W.ha[2, 1], fe[0], fe[1], fe[2], fe[3]) > extent:
+    extent = body[B_HEAD_RISE] + body[B_R_HEAD] + body[B_SHOULDER_HALF]
+    for f in range(fences.shape[0]):
+        fe = fences[f]
+        if point_segment_2d(ha[2, 0], ha[2, 1], fe[0], fe[1], fe[2], fe[3]) > extent:
             continue
         for c in (2, 3, 4, 5):
-            if segment_rectangle(W.ha[c], W.hb[c], P.fences[f], W.c1, W.c2, W.scratch) < W.hr[c]:
+            if segment_rectangle(ha[c], hb[c], fences[f], c1, c2, scratch) < hr[c]:
                 return False
     return True
 
@@ -710,11 +720,13 @@ def sense_and_measure(P, state, W, row, action):
     dt = P.scal[C_DT]
     k = state[S_K]
     t = k * dt
-    human_pose(P, state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT], W)
-    n_near = near_fences(P, W, P.body[B_ARM_LEN] + 0.05)
+    ha, hb, hr, sh, tr, c1, c2, scratch = W.ha, W.hb, W.hr, W.sh, W.tr, W.c1, W.c2, W.scratch
+    pose_body(P.body, state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT], ha, hb, hr, sh, tr)
+    n_near = collect_near_fences(P.fences, sh, W.near, P.body[B_ARM_LEN] + 0.05)
     seen = 0
-    for d in range(P.dev_kind.shape[0]):
-        if device_sees(P, d, W, n_near):
+    dev_kind, dev_rect, dev_poly, dev_verts, body = P.dev_kind, P.dev_rect, P.dev_poly, P.dev_verts, P.body
+    for d in range(dev_kind.shape[0]):
+        if device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr, c1, c2, scratch):
             seen |= 1 << d
             t_s = t + P.dev_resp[d]
             if t_s < state[S_TSTOP]:
@@ -769,6 +781,9 @@ def step_action(P, state, action, W, out, row0):
     df = P.act[action, 2] - f0
     dl = P.act[action, 3] - l0
     stride = P.body[B_WALK_SPEED] * P.scal[C_DT]
+    body, fences, floor, table_verts, table_poly = P.body, P.fences, P.floor, P.table_verts, P.table_poly
+    radius = body[B_BODY_RADIUS]
+    ha, hb, hr, sh, tr, c1, c2, scratch = W.ha, W.hb, W.hr, W.sh, W.tr, W.c1, W.c2, W.scratch
     n = 0
     for j in range(1, spa + 1):
         frac = j / spa
@@ -777,13 +792,13 @@ def step_action(P, state, action, W, out, row0):
         nx, ny = x, y
         if walks != 0.0:
             nx, ny = x + stride * np.cos(h), y + stride * np.sin(h)
-            if not feet_ok(P, nx, ny):
+            if not feet_ok(radius, floor, table_verts, table_poly, fences, nx, ny):
                 nx, ny = x, y
-        human_pose(P, nx, ny, h, f, l, W)
-        if not trunk_clear(P, W):
+        pose_body(body, nx, ny, h, f, l, ha, hb, hr, sh, tr)
+        if not trunk_clear(body, fences, ha, hb, hr, c1, c2, scratch):
             # the new posture would put the trunk through a fence: keep the old posture where it stands
-            human_pose(P, nx, ny, state[S_HEADING], state[S_FWD], state[S_LAT], W)
-            if trunk_clear(P, W):
+            pose_body(body, nx, ny, state[S_HEADING], state[S_FWD], state[S_LAT], ha, hb, hr, sh, tr)
+            if trunk_clear(body, fences, ha, hb, hr, c1, c2, scratch):
                 h, f, l = state[S_HEADING], state[S_FWD], state[S_LAT]
             else:
                 nx, ny, h, f, l = x, y, state[S_HEADING], state[S_FWD], state[S_LAT]
