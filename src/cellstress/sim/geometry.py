@@ -18,13 +18,22 @@ def _clamp01(x):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def segment_segment(p1, q1, p2, q2, c1, c2):
-    """Squared distance between segments p1q1 and p2q2; closest points written to c1, c2.
+    """Squared distance between segments p1q1 and p2q2; closest points written to c1, c2."""
+    d2, c1[0], c1[1], c1[2], c2[0], c2[1], c2[2] = segment_segment_xyz(
+        p1[0], p1[1], p1[2], q1[0], q1[1], q1[2], p2[0], p2[1], p2[2], q2[0], q2[1], q2[2])
+    return d2
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def segment_segment_xyz(p1x, p1y, p1z, q1x, q1y, q1z, p2x, p2y, p2z, q2x, q2y, q2z):
+    """(squared distance, closest point on p1q1, closest point on p2q2) for two segments given by coordinates.
 
     Ericson, *Real-Time Collision Detection* (2005), sec. 5.1.9, with both degenerate cases handled.
+    (Scalars in and out: the hot loops call this, and arrays or row views would be reference-counted.)
     """
-    d1x, d1y, d1z = q1[0] - p1[0], q1[1] - p1[1], q1[2] - p1[2]
-    d2x, d2y, d2z = q2[0] - p2[0], q2[1] - p2[1], q2[2] - p2[2]
-    rx, ry, rz = p1[0] - p2[0], p1[1] - p2[1], p1[2] - p2[2]
+    d1x, d1y, d1z = q1x - p1x, q1y - p1y, q1z - p1z
+    d2x, d2y, d2z = q2x - p2x, q2y - p2y, q2z - p2z
+    rx, ry, rz = p1x - p2x, p1y - p2y, p1z - p2z
     a = d1x * d1x + d1y * d1y + d1z * d1z
     e = d2x * d2x + d2y * d2y + d2z * d2z
     f = d2x * rx + d2y * ry + d2z * rz
@@ -50,10 +59,10 @@ def segment_segment(p1, q1, p2, q2, c1, c2):
             elif t > 1.0:
                 t = 1.0
                 s = _clamp01((b - c) / a)
-    c1[0], c1[1], c1[2] = p1[0] + d1x * s, p1[1] + d1y * s, p1[2] + d1z * s
-    c2[0], c2[1], c2[2] = p2[0] + d2x * t, p2[1] + d2y * t, p2[2] + d2z * t
-    dx, dy, dz = c1[0] - c2[0], c1[1] - c2[1], c1[2] - c2[2]
-    return dx * dx + dy * dy + dz * dz
+    c1x, c1y, c1z = p1x + d1x * s, p1y + d1y * s, p1z + d1z * s
+    c2x, c2y, c2z = p2x + d2x * t, p2y + d2y * t, p2z + d2z * t
+    dx, dy, dz = c1x - c2x, c1y - c2y, c1z - c2z
+    return dx * dx + dy * dy + dz * dz, c1x, c1y, c1z, c2x, c2y, c2z
 
 
 @njit(cache=True, error_model="numpy")
@@ -102,58 +111,61 @@ def segment_rectangle(a, b, rect, c1, c2, scratch):
     """Distance between segment ab and a vertical rectangle.
 
     rect = (x0, y0, x1, y1, zlo, zhi): the rectangle spans the floor segment (x0, y0)-(x1, y1) between heights
-    zlo and zhi. Closest points go to c1 (segment) and c2 (rectangle). scratch is a (4, 3) work array.
+    zlo and zhi. Closest points go to c1 (segment) and c2 (rectangle). (scratch is unused, kept for callers.)
     """
-    x0, y0, x1, y1, zlo, zhi = rect[0], rect[1], rect[2], rect[3], rect[4], rect[5]
+    d, c1[0], c1[1], c1[2], c2[0], c2[1], c2[2] = segment_rectangle_xyz(
+        a[0], a[1], a[2], b[0], b[1], b[2], rect[0], rect[1], rect[2], rect[3], rect[4], rect[5])
+    return d
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def segment_rectangle_xyz(ax, ay, az, bx, by, bz, x0, y0, x1, y1, zlo, zhi):
+    """(distance, closest point on the segment, closest point on the rectangle) for segment ab and the
+    vertical rectangle over the floor segment (x0, y0)-(x1, y1) between heights zlo and zhi."""
     ux, uy = x1 - x0, y1 - y0
     w = np.sqrt(ux * ux + uy * uy)
     ux /= w
     uy /= w
     nx, ny = -uy, ux
     # signed distances of the endpoints from the rectangle's plane
-    sa = (a[0] - x0) * nx + (a[1] - y0) * ny
-    sb = (b[0] - x0) * nx + (b[1] - y0) * ny
+    sa = (ax - x0) * nx + (ay - y0) * ny
+    sb = (bx - x0) * nx + (by - y0) * ny
     if sa * sb <= 0.0 and sa != sb:
         t = sa / (sa - sb)
-        cx, cy, cz = a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])
+        cx, cy, cz = ax + t * (bx - ax), ay + t * (by - ay), az + t * (bz - az)
         u = (cx - x0) * ux + (cy - y0) * uy
         if 0.0 <= u <= w and zlo <= cz <= zhi:
-            c1[0], c1[1], c1[2] = cx, cy, cz
-            c2[0], c2[1], c2[2] = cx, cy, cz
-            return 0.0
+            return 0.0, cx, cy, cz, cx, cy, cz
     best = np.inf
+    c1x = c1y = c1z = c2x = c2y = c2z = 0.0
     # endpoints against the rectangle face
     for k in range(2):
-        p = a if k == 0 else b
-        u = (p[0] - x0) * ux + (p[1] - y0) * uy
+        px, py, pz = (ax, ay, az) if k == 0 else (bx, by, bz)
+        u = (px - x0) * ux + (py - y0) * uy
         u = 0.0 if u < 0.0 else (w if u > w else u)
-        z = zlo if p[2] < zlo else (zhi if p[2] > zhi else p[2])
+        z = zlo if pz < zlo else (zhi if pz > zhi else pz)
         qx, qy = x0 + u * ux, y0 + u * uy
-        d2 = (p[0] - qx) ** 2 + (p[1] - qy) ** 2 + (p[2] - z) ** 2
+        d2 = (px - qx) ** 2 + (py - qy) ** 2 + (pz - z) ** 2
         if d2 < best:
             best = d2
-            c1[0], c1[1], c1[2] = p[0], p[1], p[2]
-            c2[0], c2[1], c2[2] = qx, qy, z
+            c1x, c1y, c1z = px, py, pz
+            c2x, c2y, c2z = qx, qy, z
     # the segment against the four edges
-    e0 = scratch[0]
-    e1 = scratch[1]
-    t1 = scratch[2]
-    t2 = scratch[3]
     for k in range(4):
         if k == 0:
-            e0[0], e0[1], e0[2], e1[0], e1[1], e1[2] = x0, y0, zlo, x1, y1, zlo
+            e0x, e0y, e0z, e1x, e1y, e1z = x0, y0, zlo, x1, y1, zlo
         elif k == 1:
-            e0[0], e0[1], e0[2], e1[0], e1[1], e1[2] = x0, y0, zhi, x1, y1, zhi
+            e0x, e0y, e0z, e1x, e1y, e1z = x0, y0, zhi, x1, y1, zhi
         elif k == 2:
-            e0[0], e0[1], e0[2], e1[0], e1[1], e1[2] = x0, y0, zlo, x0, y0, zhi
+            e0x, e0y, e0z, e1x, e1y, e1z = x0, y0, zlo, x0, y0, zhi
         else:
-            e0[0], e0[1], e0[2], e1[0], e1[1], e1[2] = x1, y1, zlo, x1, y1, zhi
-        d2 = segment_segment(a, b, e0, e1, t1, t2)
+            e0x, e0y, e0z, e1x, e1y, e1z = x1, y1, zlo, x1, y1, zhi
+        d2, t1x, t1y, t1z, t2x, t2y, t2z = segment_segment_xyz(ax, ay, az, bx, by, bz, e0x, e0y, e0z, e1x, e1y, e1z)
         if d2 < best:
             best = d2
-            c1[0], c1[1], c1[2] = t1[0], t1[1], t1[2]
-            c2[0], c2[1], c2[2] = t2[0], t2[1], t2[2]
-    return np.sqrt(best)
+            c1x, c1y, c1z = t1x, t1y, t1z
+            c2x, c2y, c2z = t2x, t2y, t2z
+    return np.sqrt(best), c1x, c1y, c1z, c2x, c2y, c2z
 
 
 @njit(cache=True, error_model="numpy")

@@ -17,12 +17,10 @@ import numpy as np
 from numba import njit, prange
 
 from cellstress.sim.geometry import (
-    point_in_polygon,
     point_segment_2d,
     polygon_distance,
-    segment_crosses_rectangle,
-    segment_rectangle,
-    segment_segment,
+    segment_rectangle_xyz,
+    segment_segment_xyz,
 )
 
 # ---- state vector -----------------------------------------------------------------------------------------
@@ -380,17 +378,17 @@ def _edge_detour(sx, sy, sz, qx, qy, qz, ex, ey, ez, dx, dy, dz, length):
 def _path_clear(fences, near, n_near, ax, ay, az, bx, by, bz):
     """No near fence panel lies across the straight segment a-b."""
     for m in range(n_near):
-        r = fences[near[m]]
-        ux, uy = r[2] - r[0], r[3] - r[1]
+        i = near[m]
+        ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
         nx, ny = -uy, ux
-        sa = (ax - r[0]) * nx + (ay - r[1]) * ny
-        sb = (bx - r[0]) * nx + (by - r[1]) * ny
+        sa = (ax - fences[i, 0]) * nx + (ay - fences[i, 1]) * ny
+        sb = (bx - fences[i, 0]) * nx + (by - fences[i, 1]) * ny
         if sa * sb >= 0.0:
             continue
         t = sa / (sa - sb)
         cx, cy, cz = ax + t * (bx - ax), ay + t * (by - ay), az + t * (bz - az)
-        u = ((cx - r[0]) * ux + (cy - r[1]) * uy) / (ux * ux + uy * uy)
-        if 0.0 <= u <= 1.0 and r[4] <= cz <= r[5]:
+        u = ((cx - fences[i, 0]) * ux + (cy - fences[i, 1]) * uy) / (ux * ux + uy * uy)
+        if 0.0 <= u <= 1.0 and fences[i, 4] <= cz <= fences[i, 5]:
             return False
     return True
 
@@ -404,21 +402,23 @@ def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz):
     best = np.inf
     nudge = 0.01  # step the bend point off the panel so the crossing tests are not degenerate
     for m in range(n_near):
-        r = fences[near[m]]
-        ux, uy = r[2] - r[0], r[3] - r[1]
+        i = near[m]
+        ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
         w = np.sqrt(ux * ux + uy * uy)
         ux /= w
         uy /= w
         for edge in range(3):
             if edge == 0:  # top edge
-                length, t = _edge_detour(sx, sy, sz, qx, qy, qz, r[0], r[1], r[5], ux, uy, 0.0, w)
-                ex, ey, ez = r[0] + t * ux, r[1] + t * uy, r[5] + nudge
+                length, t = _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 5],
+                                         ux, uy, 0.0, w)
+                ex, ey, ez = fences[i, 0] + t * ux, fences[i, 1] + t * uy, fences[i, 5] + nudge
             else:  # vertical end edges
                 sgn = -1.0 if edge == 1 else 1.0
-                bx = r[0] if edge == 1 else r[2]
-                by = r[1] if edge == 1 else r[3]
-                length, t = _edge_detour(sx, sy, sz, qx, qy, qz, bx, by, r[4], 0.0, 0.0, 1.0, r[5] - r[4])
-                ex, ey, ez = bx + sgn * nudge * ux, by + sgn * nudge * uy, r[4] + t
+                bx = fences[i, 0] if edge == 1 else fences[i, 2]
+                by = fences[i, 1] if edge == 1 else fences[i, 3]
+                length, t = _edge_detour(sx, sy, sz, qx, qy, qz, bx, by, fences[i, 4], 0.0, 0.0, 1.0,
+                                         fences[i, 5] - fences[i, 4])
+                ex, ey, ez = bx + sgn * nudge * ux, by + sgn * nudge * uy, fences[i, 4] + t
             if (length < best and _path_clear(fences, near, n_near, sx, sy, sz, ex, ey, ez)
                     and _path_clear(fences, near, n_near, ex, ey, ez, qx, qy, qz)):
                 best = length
@@ -474,9 +474,9 @@ def near_fences(P, W, margin):
 def collect_near_fences(fences, sh, near, margin):
     n = 0
     for f in range(fences.shape[0]):
-        r = fences[f]
-        d0 = point_segment_2d(sh[0, 0], sh[0, 1], r[0], r[1], r[2], r[3])
-        d1 = point_segment_2d(sh[1, 0], sh[1, 1], r[0], r[1], r[2], r[3])
+        x0, y0, x1, y1 = fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3]
+        d0 = point_segment_2d(sh[0, 0], sh[0, 1], x0, y0, x1, y1)
+        d1 = point_segment_2d(sh[1, 0], sh[1, 1], x0, y0, x1, y1)
         if d0 < margin or d1 < margin:
             near[n] = f
             n += 1
@@ -517,7 +517,7 @@ def reach_to_segment(reach, origin, h, arm_len, fences, near, sh, tr, side, n_ne
 
 # ---- sensing ----------------------------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy", inline="always")
-def device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr, c1, c2, scratch):
+def device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
     """Does device d detect the worker: a body capsule (legs, trunk, head, arms at rest) in its region?
 
     The reach volumes are not seen: they stand for where an arm *could* strike, and the worst-case worker
@@ -527,29 +527,31 @@ def device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr, c1
         H = dev_rect[d, 4]
         start, count = dev_poly[d, 0], dev_poly[d, 1]
         for c in range(N_BODY_CAPSULES):
-            a, b, r = ha[c], hb[c], hr[c]
-            lo, hi = min(a[2], b[2]), max(a[2], b[2])
+            a0, a1, a2, b0, b1, b2, r = ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2], hr[c]
+            lo, hi = min(a2, b2), max(a2, b2)
             if H < lo - r or H > hi + r:
                 continue
-            if b[2] == a[2]:
+            if b2 == a2:
                 t = 0.0
             else:
-                t = (H - a[2]) / (b[2] - a[2])
+                t = (H - a2) / (b2 - a2)
                 t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
-            px, py, pz = a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])
+            px, py, pz = a0 + t * (b0 - a0), a1 + t * (b1 - a1), a2 + t * (b2 - a2)
             dz = abs(pz - H)
             if dz > r:
                 continue
             if polygon_distance(px, py, dev_verts, start, count) <= np.sqrt(r * r - dz * dz):
                 return True
     else:
-        r = dev_rect[d]
+        x0, y0, x1, y1, zlo, zhi = dev_rect[d, 0], dev_rect[d, 1], dev_rect[d, 2], dev_rect[d, 3], \
+            dev_rect[d, 4], dev_rect[d, 5]
         # no body capsule is further than this from the hip axis in plan view
         extent = body[B_SHOULDER_HALF] + body[B_R_TRUNK] + body[B_HEAD_RISE]
-        if point_segment_2d(ha[2, 0], ha[2, 1], r[0], r[1], r[2], r[3]) > extent:
+        if point_segment_2d(ha[2, 0], ha[2, 1], x0, y0, x1, y1) > extent:
             return False
         for c in range(N_BODY_CAPSULES):
-            if segment_rectangle(ha[c], hb[c], r, c1, c2, scratch) <= hr[c]:
+            if segment_rectangle_xyz(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2],
+                                     x0, y0, x1, y1, zlo, zhi)[0] <= hr[c]:
                 return True
     return False
 
@@ -564,14 +566,14 @@ def feet_ok(r, fl, table_verts, table_poly, fences, x, y):
         if polygon_distance(x, y, table_verts, table_poly[t, 0], table_poly[t, 1]) < r:
             return False
     for f in range(fences.shape[0]):
-        fe = fences[f]
-        if fe[4] < WALK_BLOCK_HEIGHT and point_segment_2d(x, y, fe[0], fe[1], fe[2], fe[3]) < r:
+        if fences[f, 4] < WALK_BLOCK_HEIGHT and \
+                point_segment_2d(x, y, fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3]) < r:
             return False
     return True
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def trunk_clear(body, fences, ha, hb, hr, c1, c2, scratch):
+def trunk_clear(body, fences, ha, hb, hr):
     """Trunk, head and arms (from the shoulders down) do not pass through any fence panel.
 
     The shoulders matter most: the reach volumes hang on them, so a shoulder past a panel would reach
@@ -579,11 +581,12 @@ def trunk_clear(body, fences, ha, hb, hr, c1, c2, scratch):
     """
     extent = body[B_HEAD_RISE] + body[B_R_HEAD] + body[B_SHOULDER_HALF]
     for f in range(fences.shape[0]):
-        fe = fences[f]
-        if point_segment_2d(ha[2, 0], ha[2, 1], fe[0], fe[1], fe[2], fe[3]) > extent:
+        x0, y0, x1, y1, zlo, zhi = fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3], fences[f, 4], fences[f, 5]
+        if point_segment_2d(ha[2, 0], ha[2, 1], x0, y0, x1, y1) > extent:
             continue
         for c in (2, 3, 4, 5):
-            if segment_rectangle(ha[c], hb[c], fences[f], c1, c2, scratch) < hr[c]:
+            if segment_rectangle_xyz(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2],
+                                     x0, y0, x1, y1, zlo, zhi)[0] < hr[c]:
                 return False
     return True
 
@@ -684,11 +687,14 @@ def separation(P, W, n_near, row):
             lb = np.sqrt((mx - hx) ** 2 + (my - hy) ** 2 + (mz - hz) ** 2) - half - hh - r - hr[h]
             if lb >= best:
                 continue
-            d = np.sqrt(segment_segment(ra[c], rb[c], ha[h], hb[h], W.c1, W.c2)) - r - hr[h]
+            d2, c1x, c1y, c1z, c2x, c2y, c2z = segment_segment_xyz(
+                ra[c, 0], ra[c, 1], ra[c, 2], rb[c, 0], rb[c, 1], rb[c, 2],
+                ha[h, 0], ha[h, 1], ha[h, 2], hb[h, 0], hb[h, 1], hb[h, 2])
+            d = np.sqrt(d2) - r - hr[h]
             if d < best:
                 best, best_cap, best_part = d, c, h
-                row[M_RX], row[M_RY], row[M_RZ] = W.c1[0], W.c1[1], W.c1[2]
-                row[M_HX], row[M_HY], row[M_HZ] = W.c2[0], W.c2[1], W.c2[2]
+                row[M_RX], row[M_RY], row[M_RZ] = c1x, c1y, c1z
+                row[M_HX], row[M_HY], row[M_HZ] = c2x, c2y, c2z
     # surface points: step from the axis points towards each other by the radii
     if best_part >= PART_LEFT_REACH:
         s = W.sh[best_part - PART_LEFT_REACH]
@@ -720,13 +726,13 @@ def sense_and_measure(P, state, W, row, action):
     dt = P.scal[C_DT]
     k = state[S_K]
     t = k * dt
-    ha, hb, hr, sh, tr, c1, c2, scratch = W.ha, W.hb, W.hr, W.sh, W.tr, W.c1, W.c2, W.scratch
+    ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
     pose_body(P.body, state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT], ha, hb, hr, sh, tr)
     n_near = collect_near_fences(P.fences, sh, W.near, P.body[B_ARM_LEN] + 0.05)
     seen = 0
     dev_kind, dev_rect, dev_poly, dev_verts, body = P.dev_kind, P.dev_rect, P.dev_poly, P.dev_verts, P.body
     for d in range(dev_kind.shape[0]):
-        if device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr, c1, c2, scratch):
+        if device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
             seen |= 1 << d
             t_s = t + P.dev_resp[d]
             if t_s < state[S_TSTOP]:
@@ -783,26 +789,26 @@ def step_action(P, state, action, W, out, row0):
     stride = P.body[B_WALK_SPEED] * P.scal[C_DT]
     body, fences, floor, table_verts, table_poly = P.body, P.fences, P.floor, P.table_verts, P.table_poly
     radius = body[B_BODY_RADIUS]
-    ha, hb, hr, sh, tr, c1, c2, scratch = W.ha, W.hb, W.hr, W.sh, W.tr, W.c1, W.c2, W.scratch
+    ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
     n = 0
     for j in range(1, spa + 1):
         frac = j / spa
         x, y = state[S_X], state[S_Y]
-        h, f, l = h0 + dh * frac, f0 + df * frac, l0 + dl * frac
+        h, f, lt = h0 + dh * frac, f0 + df * frac, l0 + dl * frac
         nx, ny = x, y
         if walks != 0.0:
             nx, ny = x + stride * np.cos(h), y + stride * np.sin(h)
             if not feet_ok(radius, floor, table_verts, table_poly, fences, nx, ny):
                 nx, ny = x, y
-        pose_body(body, nx, ny, h, f, l, ha, hb, hr, sh, tr)
-        if not trunk_clear(body, fences, ha, hb, hr, c1, c2, scratch):
+        pose_body(body, nx, ny, h, f, lt, ha, hb, hr, sh, tr)
+        if not trunk_clear(body, fences, ha, hb, hr):
             # the new posture would put the trunk through a fence: keep the old posture where it stands
             pose_body(body, nx, ny, state[S_HEADING], state[S_FWD], state[S_LAT], ha, hb, hr, sh, tr)
-            if trunk_clear(body, fences, ha, hb, hr, c1, c2, scratch):
-                h, f, l = state[S_HEADING], state[S_FWD], state[S_LAT]
+            if trunk_clear(body, fences, ha, hb, hr):
+                h, f, lt = state[S_HEADING], state[S_FWD], state[S_LAT]
             else:
-                nx, ny, h, f, l = x, y, state[S_HEADING], state[S_FWD], state[S_LAT]
-        state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT] = nx, ny, h, f, l
+                nx, ny, h, f, lt = x, y, state[S_HEADING], state[S_FWD], state[S_LAT]
+        state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT] = nx, ny, h, f, lt
         state[S_K] += 1.0
         unsafe = sense_and_measure(P, state, W, out[row0 + n], action)
         n += 1
