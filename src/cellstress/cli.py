@@ -206,6 +206,8 @@ def simulate(
                                          "walk+upright,turn-left-45+bend-forward (WALK+BODY).")],
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON document instead of the table.")] \
         = False,
+    criterion: Annotated[str | None, typer.Option("--criterion", help="contact-while-moving or iso15066; "
+                                                  "default: the cell file's.")] = None,
 ) -> None:
     """Play a sequence of worker actions in a cell and report whether it ends in an unsafe contact."""
     from cellstress.human.actions import ACTION_NAMES, parse_actions
@@ -215,10 +217,14 @@ def simulate(
     from cellstress.cell.load import load_cell
 
     with _user_errors():
-        c = load_cell(cell)
+        _check_criterion(criterion)
+        from cellstress.criteria import with_criterion
+
+        c = with_criterion(load_cell(cell), criterion)
         from cellstress.sim.simulator import Simulator
 
-        trace = Simulator(c).run(indices)
+        sim = Simulator(c)
+        trace = sim.run(indices)
     records = trace.records()
     hit = trace.unsafe_row
     hazard = None
@@ -226,6 +232,8 @@ def simulate(
         r = records[hit]
         hazard = {k: r[k] for k in ("t", "step", "robot_link", "body_part", "robot_point", "human_point",
                                     "d_HR", "v_R")}
+        if sim.forces is not None:
+            hazard["iso15066"] = sim.forces.assess(trace.rows[hit]).as_dict()
 
     if as_json:
         doc = {"cell": c.name, "actions": [ACTION_NAMES[i] for i in indices], "steps": records,
@@ -240,6 +248,8 @@ def simulate(
     else:
         typer.echo(f"UNSAFE at t={_num(hazard['t'])} s (step {hazard['step']}): "
                    f"{hazard['robot_link']} / {hazard['body_part']}")
+        if "iso15066" in hazard:
+            typer.echo(f"iso15066  {hazard['iso15066']['reason']}")
 
 
 # ---- search -----------------------------------------------------------------------------------------------
@@ -260,6 +270,13 @@ def _check_out_dir(out: str):
     except OSError as exc:
         raise _fail(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
     return path
+
+
+def _check_criterion(name: str | None) -> None:
+    from cellstress.cell.schema import CRITERIA
+
+    if name is not None and name not in CRITERIA:
+        raise CellstressError(f"--criterion: unknown criterion {name!r} (choose from {', '.join(CRITERIA)})")
 
 
 def _params_text(params: dict) -> str:
@@ -291,6 +308,9 @@ def search(
                                           "summary.")] = False,
     no_report: Annotated[bool, typer.Option("--no-report", help="Do not write the report (pictures, "
                                             "report.html) next to result.json.")] = False,
+    criterion: Annotated[str | None, typer.Option("--criterion", help="contact-while-moving (the paper) or "
+                                                  "iso15066 (force limits per body region); default: the "
+                                                  "cell file's.")] = None,
 ) -> None:
     """Search a cell for a sequence of worker actions that ends in an unsafe contact; write result.json
     and its report (see 'cellstress report')."""
@@ -304,11 +324,14 @@ def search(
     with _user_errors():
         check_common(budget, seed, until, top_k)
         make_searcher(searcher, **options)
+        _check_criterion(criterion)
     out_dir = _check_out_dir(out)
     from cellstress.cell.load import load_cell
 
     with _user_errors():
-        c = load_cell(cell)
+        from cellstress.criteria import with_criterion
+
+        c = with_criterion(load_cell(cell), criterion)
         from cellstress.sim.simulator import Simulator
 
         sim = Simulator(c)
@@ -354,7 +377,7 @@ def search(
     best = max(result.risk_per_episode, default=0.0)
     h = result.hazard
     if h is None:
-        echo(f"no hazard in {result.episodes} episodes (best risk 1/c_S {best:.3f}; {elapsed:.2f} s, "
+        echo(f"no hazard in {result.episodes} episodes (best risk {best:.3f}; {elapsed:.2f} s, "
              f"{rate:.0f} episodes/s)")
     else:
         extra = f", {len(result.hazards)} hazardous episodes in all" if until == "budget" else ""
@@ -388,7 +411,10 @@ def replay(
     from cellstress.cell.load import load_cell
 
     with _user_errors():
-        c = load_cell(res.cell.get("source", res.cell["name"]))
+        from cellstress.criteria import with_criterion
+
+        c = with_criterion(load_cell(res.cell.get("source", res.cell["name"])),
+                           res.cell.get("criterion", "contact-while-moving"))
         from cellstress.sim.simulator import Simulator
 
         trace = Simulator(c).run(h["actions"])

@@ -209,10 +209,17 @@ class HumanSpec(_Record):
     max_lateral_flexion_deg: Annotated[float, Field(ge=0.0, le=60.0)] = 35.0
 
 
+CRITERIA = ("contact-while-moving", "iso15066")
+
+
 class CriterionSpec(_Record):
-    type: Literal["contact-while-moving"] = "contact-while-moving"
+    """What is unsafe: ``contact-while-moving`` (the paper) or ``iso15066`` (force limits per body region;
+    ``payload`` [kg] is added to the robot's reflected mass, see docs/criteria.md)."""
+
+    type: Literal["contact-while-moving", "iso15066"] = "contact-while-moving"
     distance_tolerance: Annotated[float, Field(ge=0.0, le=0.1)] = 0.0
     speed_tolerance: Annotated[float, Field(ge=0.0, le=0.1)] = 0.001
+    payload: Annotated[float, Field(ge=0.0, le=1000.0)] = 2.0
 
 
 class SimulationSpec(_Record):
