@@ -311,6 +311,8 @@ def search(
     criterion: Annotated[str | None, typer.Option("--criterion", help="contact-while-moving (the paper) or "
                                                   "iso15066 (force limits per body region); default: the "
                                                   "cell file's.")] = None,
+    distinct: Annotated[bool, typer.Option("--distinct", help="With --until budget: cluster the hazards "
+                                           "into classes, steer away from classes found, list each.")] = False,
 ) -> None:
     """Search a cell for a sequence of worker actions that ends in an unsafe contact; write result.json
     and its report (see 'cellstress report')."""
@@ -325,6 +327,8 @@ def search(
         check_common(budget, seed, until, top_k)
         make_searcher(searcher, **options)
         _check_criterion(criterion)
+        if distinct and until != "budget":
+            raise CellstressError("--distinct needs --until budget")
     out_dir = _check_out_dir(out)
     from cellstress.cell.load import load_cell
 
@@ -352,7 +356,8 @@ def search(
             progress.update(task, completed=done, rate=done / max(time.perf_counter() - t0, 1e-9), risk=best_risk)
 
     with progress, _user_errors():
-        result = run(sim, searcher, budget, seed, until=until, top_k=top_k, progress=tick, **options)
+        result = run(sim, searcher, budget, seed, until=until, top_k=top_k, progress=tick, distinct=distinct,
+                     **options)
     elapsed = time.perf_counter() - t0
     try:
         path = result.write(out_dir)
@@ -387,6 +392,11 @@ def search(
         x, y, z = h["point"]
         echo(f"contact   t={_num(h['time_s'])} s (step {h['step']}): {h['robot_link']} / {h['body_part']} at "
              f"({x:.3f}, {y:.3f}, {z:.3f}) m, robot moving at v_R {h['v_R']:.3f} m/s")
+    for i, d in enumerate(result.distinct or []):
+        k = d["class"]
+        x0, y0, x1, y1 = k["approach_cell"]
+        echo(f"class {i}   episode {d['episode']}: {k['device']} / {k['robot_link']} / {k['body_region']} at "
+             f"x {_num(x0)}..{_num(x1)}, y {_num(y0)}..{_num(y1)}  (cellstress replay {path} --hazard {i})")
     if report:
         echo(report)
     echo(f"wrote     {path}")
@@ -397,6 +407,8 @@ def search(
 def replay(
     result_file: Annotated[str, typer.Argument(help="A result.json written by 'cellstress search' (or its "
                                                "folder).")],
+    hazard_index: Annotated[int | None, typer.Option("--hazard", help="Replay the distinct hazard with this "
+                                                     "index (search --distinct) instead of the first.")] = None,
 ) -> None:
     """Re-simulate the hazard of a search result and check it bit-exactly against the recorded trace.
 
@@ -406,6 +418,12 @@ def replay(
     with _user_errors():
         res = SearchResult.load(result_file)
     h = res.hazard
+    if hazard_index is not None:
+        hs = res.distinct or []
+        if not 0 <= hazard_index < len(hs):
+            raise _fail(f"--hazard {hazard_index}: the result lists {len(hs)} distinct hazards"
+                        + (f" (0..{len(hs) - 1})" if hs else ""))
+        h = hs[hazard_index]
     if h is None:
         raise _fail(f"{result_file}: the search found no hazard; there is nothing to replay")
     from cellstress.cell.load import load_cell

@@ -186,7 +186,13 @@ class Simulator:
 
     # ---- episodes ---------------------------------------------------------------------------------------
     def run(self, actions) -> Trace:
-        """Play a whole action sequence from s0 (stopping at the first unsafe step)."""
+        """Play a whole action sequence from s0 (stopping at the first unsafe step). A leading ``start:NAME``
+        plays it from that start point of the cell's ``human.starts`` (see ``search.multistart``)."""
+        if len(actions) and isinstance(actions[0], str) and actions[0].startswith("start:"):
+            from cellstress.search.multistart import split_start
+
+            sim, rest = split_start(self, actions)
+            return sim.run(rest)
         acts = np.asarray([action_index(a) for a in actions], dtype=np.int64)
         if self.forces is not None:  # step by step, so that the criterion ends the episode
             state, parts = self.reset(), [self._row0[None, :].copy()]
