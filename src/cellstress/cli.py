@@ -206,6 +206,8 @@ def simulate(
                                          "walk+upright,turn-left-45+bend-forward (WALK+BODY).")],
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON document instead of the table.")] \
         = False,
+    criterion: Annotated[str | None, typer.Option("--criterion", help="contact-while-moving or iso15066; "
+                                                  "default: the cell file's.")] = None,
 ) -> None:
     """Play a sequence of worker actions in a cell and report whether it ends in an unsafe contact."""
     from cellstress.human.actions import ACTION_NAMES, parse_actions
@@ -215,10 +217,14 @@ def simulate(
     from cellstress.cell.load import load_cell
 
     with _user_errors():
-        c = load_cell(cell)
+        _check_criterion(criterion)
+        from cellstress.criteria import with_criterion
+
+        c = with_criterion(load_cell(cell), criterion)
         from cellstress.sim.simulator import Simulator
 
-        trace = Simulator(c).run(indices)
+        sim = Simulator(c)
+        trace = sim.run(indices)
     records = trace.records()
     hit = trace.unsafe_row
     hazard = None
@@ -226,6 +232,8 @@ def simulate(
         r = records[hit]
         hazard = {k: r[k] for k in ("t", "step", "robot_link", "body_part", "robot_point", "human_point",
                                     "d_HR", "v_R")}
+        if sim.forces is not None:
+            hazard["iso15066"] = sim.forces.assess(trace.rows[hit]).as_dict()
 
     if as_json:
         doc = {"cell": c.name, "actions": [ACTION_NAMES[i] for i in indices], "steps": records,
@@ -240,6 +248,8 @@ def simulate(
     else:
         typer.echo(f"UNSAFE at t={_num(hazard['t'])} s (step {hazard['step']}): "
                    f"{hazard['robot_link']} / {hazard['body_part']}")
+        if "iso15066" in hazard:
+            typer.echo(f"iso15066  {hazard['iso15066']['reason']}")
 
 
 # ---- search -----------------------------------------------------------------------------------------------
@@ -260,6 +270,13 @@ def _check_out_dir(out: str):
     except OSError as exc:
         raise _fail(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
     return path
+
+
+def _check_criterion(name: str | None) -> None:
+    from cellstress.cell.schema import CRITERIA
+
+    if name is not None and name not in CRITERIA:
+        raise CellstressError(f"--criterion: unknown criterion {name!r} (choose from {', '.join(CRITERIA)})")
 
 
 def _params_text(params: dict) -> str:
@@ -291,6 +308,11 @@ def search(
                                           "summary.")] = False,
     no_report: Annotated[bool, typer.Option("--no-report", help="Do not write the report (pictures, "
                                             "report.html) next to result.json.")] = False,
+    criterion: Annotated[str | None, typer.Option("--criterion", help="contact-while-moving (the paper) or "
+                                                  "iso15066 (force limits per body region); default: the "
+                                                  "cell file's.")] = None,
+    distinct: Annotated[bool, typer.Option("--distinct", help="With --until budget: cluster the hazards "
+                                           "into classes, steer away from classes found, list each.")] = False,
 ) -> None:
     """Search a cell for a sequence of worker actions that ends in an unsafe contact; write result.json
     and its report (see 'cellstress report')."""
@@ -304,11 +326,16 @@ def search(
     with _user_errors():
         check_common(budget, seed, until, top_k)
         make_searcher(searcher, **options)
+        _check_criterion(criterion)
+        if distinct and until != "budget":
+            raise CellstressError("--distinct needs --until budget")
     out_dir = _check_out_dir(out)
     from cellstress.cell.load import load_cell
 
     with _user_errors():
-        c = load_cell(cell)
+        from cellstress.criteria import with_criterion
+
+        c = with_criterion(load_cell(cell), criterion)
         from cellstress.sim.simulator import Simulator
 
         sim = Simulator(c)
@@ -329,7 +356,8 @@ def search(
             progress.update(task, completed=done, rate=done / max(time.perf_counter() - t0, 1e-9), risk=best_risk)
 
     with progress, _user_errors():
-        result = run(sim, searcher, budget, seed, until=until, top_k=top_k, progress=tick, **options)
+        result = run(sim, searcher, budget, seed, until=until, top_k=top_k, progress=tick, distinct=distinct,
+                     **options)
     elapsed = time.perf_counter() - t0
     try:
         path = result.write(out_dir)
@@ -354,7 +382,7 @@ def search(
     best = max(result.risk_per_episode, default=0.0)
     h = result.hazard
     if h is None:
-        echo(f"no hazard in {result.episodes} episodes (best risk 1/c_S {best:.3f}; {elapsed:.2f} s, "
+        echo(f"no hazard in {result.episodes} episodes (best risk {best:.3f}; {elapsed:.2f} s, "
              f"{rate:.0f} episodes/s)")
     else:
         extra = f", {len(result.hazards)} hazardous episodes in all" if until == "budget" else ""
@@ -364,6 +392,11 @@ def search(
         x, y, z = h["point"]
         echo(f"contact   t={_num(h['time_s'])} s (step {h['step']}): {h['robot_link']} / {h['body_part']} at "
              f"({x:.3f}, {y:.3f}, {z:.3f}) m, robot moving at v_R {h['v_R']:.3f} m/s")
+    for i, d in enumerate(result.distinct or []):
+        k = d["class"]
+        x0, y0, x1, y1 = k["approach_cell"]
+        echo(f"class {i}   episode {d['episode']}: {k['device']} / {k['robot_link']} / {k['body_region']} at "
+             f"x {_num(x0)}..{_num(x1)}, y {_num(y0)}..{_num(y1)}  (cellstress replay {path} --hazard {i})")
     if report:
         echo(report)
     echo(f"wrote     {path}")
@@ -374,6 +407,8 @@ def search(
 def replay(
     result_file: Annotated[str, typer.Argument(help="A result.json written by 'cellstress search' (or its "
                                                "folder).")],
+    hazard_index: Annotated[int | None, typer.Option("--hazard", help="Replay the distinct hazard with this "
+                                                     "index (search --distinct) instead of the first.")] = None,
 ) -> None:
     """Re-simulate the hazard of a search result and check it bit-exactly against the recorded trace.
 
@@ -383,12 +418,21 @@ def replay(
     with _user_errors():
         res = SearchResult.load(result_file)
     h = res.hazard
+    if hazard_index is not None:
+        hs = res.distinct or []
+        if not 0 <= hazard_index < len(hs):
+            raise _fail(f"--hazard {hazard_index}: the result lists {len(hs)} distinct hazards"
+                        + (f" (0..{len(hs) - 1})" if hs else ""))
+        h = hs[hazard_index]
     if h is None:
         raise _fail(f"{result_file}: the search found no hazard; there is nothing to replay")
     from cellstress.cell.load import load_cell
 
     with _user_errors():
-        c = load_cell(res.cell.get("source", res.cell["name"]))
+        from cellstress.criteria import with_criterion
+
+        c = with_criterion(load_cell(res.cell.get("source", res.cell["name"])),
+                           res.cell.get("criterion", "contact-while-moving"))
         from cellstress.sim.simulator import Simulator
 
         trace = Simulator(c).run(h["actions"])

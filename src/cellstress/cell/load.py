@@ -16,7 +16,7 @@ from pydantic import BaseModel, ValidationError
 from cellstress.cell.schema import CellSpec
 from cellstress.errors import CellError
 
-BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap")
+BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap", "all-flaws")
 
 
 @dataclass(frozen=True)

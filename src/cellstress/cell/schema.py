@@ -201,18 +201,40 @@ class StartSpec(_Record):
     heading_deg: float = Field(allow_inf_nan=False)
 
 
+class NamedStart(StartSpec):
+    name: Annotated[str, Field(min_length=1, pattern=r"^[A-Za-z0-9_.-]+$")]
+
+
 class HumanSpec(_Record):
     start: StartSpec
+    # the start points a search chooses from, one per episode (its first decision); empty: ``start`` only
+    starts: tuple[NamedStart, ...] = ()
     anthropometry: Anthropometry = Anthropometry()
     walking_speed: Length = 1.6
     max_forward_flexion_deg: Annotated[float, Field(ge=0.0, le=90.0)] = 55.0
     max_lateral_flexion_deg: Annotated[float, Field(ge=0.0, le=60.0)] = 35.0
 
+    @field_validator("starts")
+    @classmethod
+    def _unique_start_names(cls, v: tuple[NamedStart, ...]) -> tuple[NamedStart, ...]:
+        names = [s.name for s in v]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise ValueError(f"start names must be unique: {', '.join(dup)} appears more than once")
+        return v
+
+
+CRITERIA = ("contact-while-moving", "iso15066")
+
 
 class CriterionSpec(_Record):
-    type: Literal["contact-while-moving"] = "contact-while-moving"
+    """What is unsafe: ``contact-while-moving`` (the paper) or ``iso15066`` (force limits per body region;
+    ``payload`` [kg] is added to the robot's reflected mass, see docs/criteria.md)."""
+
+    type: Literal["contact-while-moving", "iso15066"] = "contact-while-moving"
     distance_tolerance: Annotated[float, Field(ge=0.0, le=0.1)] = 0.0
     speed_tolerance: Annotated[float, Field(ge=0.0, le=0.1)] = 0.001
+    payload: Annotated[float, Field(ge=0.0, le=1000.0)] = 2.0
 
 
 class SimulationSpec(_Record):

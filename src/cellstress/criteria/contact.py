@@ -39,5 +39,26 @@ class ContactWhileMoving:
         return 1.0 / c
 
 
-def criterion_for(spec: CriterionSpec) -> ContactWhileMoving:
+def criterion_for(spec: CriterionSpec):
+    """The criterion object of a cell file's ``criterion`` record."""
+    if spec.type == "iso15066":
+        from cellstress.criteria.iso15066 import Iso15066
+
+        return Iso15066(spec.distance_tolerance, spec.speed_tolerance, spec.payload)
     return ContactWhileMoving(spec.distance_tolerance, spec.speed_tolerance)
+
+
+def with_criterion(cell, name: str | None):
+    """``cell`` judged by the criterion ``name`` (its tolerances kept); the cell itself if ``name`` is None or
+    already its criterion. CellstressError for an unknown name."""
+    from dataclasses import replace
+
+    from cellstress.cell.schema import CRITERIA
+    from cellstress.errors import CellstressError
+
+    if name is None or name == cell.spec.criterion.type:
+        return cell
+    if name not in CRITERIA:
+        raise CellstressError(f"unknown criterion {name!r} (choose from {', '.join(CRITERIA)})")
+    crit = cell.spec.criterion.model_copy(update={"type": name})
+    return replace(cell, spec=cell.spec.model_copy(update={"criterion": crit}))

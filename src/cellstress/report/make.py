@@ -60,7 +60,10 @@ def _simulator(res: SearchResult, sim):
     if sim is not None and sim.cell.sha256 == res.cell.get("sha256"):
         return sim
     try:
-        return Simulator(load_cell(res.cell.get("source", res.cell["name"])))
+        from cellstress.criteria import with_criterion
+
+        return Simulator(with_criterion(load_cell(res.cell.get("source", res.cell["name"])),
+                                        res.cell.get("criterion", "contact-while-moving")))
     except CellstressError as exc:
         raise ReportError(f"cannot load the result's cell: {exc}") from None
 

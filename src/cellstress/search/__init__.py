@@ -49,11 +49,12 @@ def make_searcher(name: str, **options):
 
 
 def run_search(problem, reward, searcher="mcts", budget=DEFAULT_BUDGET, seed=0, *, until="first",
-               top_k=DEFAULT_TOP_K, progress=None, **options) -> Outcome:
-    """Search any ``Problem`` (e.g. a toy) with a reward ``reward(d, v, last_action, unsafe) -> (r, risk)``."""
+               top_k=DEFAULT_TOP_K, progress=None, recorder=None, **options) -> Outcome:
+    """Search any ``Problem`` (e.g. a toy) with a reward ``reward(d, v, last_action, unsafe) -> (r, risk)``.
+    ``recorder``: a ``Recorder`` made by the caller (e.g. ``distinct.DistinctRecorder``)."""
     check_common(budget, seed, until, top_k)
     s = searcher if not isinstance(searcher, str) else make_searcher(searcher, **options)
-    rec = Recorder(int(budget), until, int(top_k), progress)
+    rec = recorder if recorder is not None else Recorder(int(budget), until, int(top_k), progress)
     try:
         s.run(problem, reward, rec, int(seed))
     except Stop:
@@ -62,32 +63,56 @@ def run_search(problem, reward, searcher="mcts", budget=DEFAULT_BUDGET, seed=0, 
 
 
 def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int = 0, *, until: str = "first",
-           top_k: int = DEFAULT_TOP_K, progress=None, **options) -> SearchResult:
+           top_k: int = DEFAULT_TOP_K, progress=None, distinct: bool = False, **options) -> SearchResult:
     """Search a cell (built-in name, path, ``Cell`` or ``Simulator``) for an unsafe action sequence.
 
     ``searcher`` is ``random``, ``mcts`` or ``mcts-commit``; ``options`` are its parameters (see
     ``MCTS``, ``MCTSCommit``, ``RandomSearch``). ``until="first"`` stops at the first hazard,
     ``until="budget"`` plays the whole budget. ``progress(episodes, best_risk)`` is called after each episode.
+    ``distinct=True`` (with ``until="budget"``) clusters the hazards into classes and steers the search away
+    from classes already found (``search.distinct``); the result lists each class's first hazard. A cell with
+    several start points (``human.starts``) lets each episode's first decision pick one (``search.multistart``).
     """
     from cellstress import __version__
-    from cellstress.criteria import criterion_for
     from cellstress.human.actions import ACTION_NAMES
+    from cellstress.search.common import make_reward
     from cellstress.sim.simulator import Simulator
 
     check_common(budget, seed, until, top_k)
     s = make_searcher(searcher, **options)
     sim = cell if isinstance(cell, Simulator) else Simulator(cell)
     c = sim.cell
-    reward = Reward(criterion_for(c.spec.criterion))
-    out = run_search(SimProblem(sim), reward, s, budget, seed, until=until, top_k=top_k, progress=progress)
+    if distinct and until != "budget":
+        raise SearchError("distinct needs until='budget' (--until budget --distinct)")
+    reward = make_reward(sim)
+    problem = SimProblem(sim)
+    names = None
+    if c.spec.human.starts:
+        from cellstress.search.multistart import MultiStartProblem
 
-    def names(actions):
-        return [ACTION_NAMES[a] for a in actions]
+        problem = MultiStartProblem(sim)
+        names = problem.names
+    rec = None
+    if distinct:
+        from cellstress.search.distinct import DistinctProblem, DistinctRecorder, DistinctReward
+
+        problem = DistinctProblem(problem, sim, reward)
+        reward = DistinctReward(reward)
+        rec = DistinctRecorder(int(budget), until, int(top_k), progress, problem=problem)
+    out = run_search(problem, reward, s, budget, seed, until=until, top_k=top_k, progress=progress, recorder=rec)
+
+    if names is None:
+        def names(actions):
+            return [ACTION_NAMES[a] for a in actions]
+
+    def hazard_record(actions):
+        trace = sim.run(names(actions))
+        return trace, trace.records()[trace.unsafe_row]
 
     hazard = None
     first = out.first_hazard
     if first is not None:
-        trace = sim.run(list(first.actions))
+        trace = sim.run(names(first.actions))
         records = trace.records()
         hit = records[trace.unsafe_row]
         hazard = {
@@ -103,10 +128,13 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
             "d_HR": hit["d_HR"],
             "trace": records,
         }
+        if sim.forces is not None:
+            hazard["iso15066"] = sim.forces.assess(trace.rows[trace.unsafe_row]).as_dict()
     return SearchResult(
         # a cell file by its absolute path, so that `cellstress replay` works from any folder
         cell={"name": c.name, "sha256": c.sha256,
-              "source": c.source if c.directory is None else str(Path(c.source).expanduser().resolve())},
+              "source": c.source if c.directory is None else str(Path(c.source).expanduser().resolve()),
+              **_criterion_override(c)},
         searcher=s.name,
         params=asdict(s),
         seed=int(seed),
@@ -120,7 +148,27 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
               "unsafe": e.unsafe} for e in out.top],
         risk_per_episode=list(out.risks),
         version=__version__,
+        distinct=None if rec is None else _distinct_list(rec.classes, names, hazard_record),
     )
+
+
+def _distinct_list(classes, names, hazard_record) -> list[dict]:
+    from cellstress.search.distinct import class_dict
+
+    out = []
+    for key, (episode, actions) in classes.items():
+        trace, hit = hazard_record(actions)
+        out.append({"class": class_dict(key), "episode": episode, "actions": names(actions), "step": hit["step"],
+                    "time_s": hit["t"], "robot_link": hit["robot_link"], "body_part": hit["body_part"],
+                    "v_R": hit["v_R"], "trace": trace.records()})
+    return out
+
+
+def _criterion_override(cell) -> dict:
+    """{"criterion": name} unless the cell is judged by the paper's criterion (the default, which keeps older
+    result files as they were); replay and report apply it with ``criteria.with_criterion``."""
+    t = cell.spec.criterion.type
+    return {} if t == "contact-while-moving" else {"criterion": t}
 
 
 class _CallableModule(type(sys.modules[__name__])):

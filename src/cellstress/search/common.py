@@ -57,11 +57,32 @@ class SimProblem:
         self.reset = sim.reset
         self.step = sim.step
         self.is_unsafe = sim.is_unsafe
-        self.run_batch = _sim_run_batch(sim, K)
+        self.forces = getattr(sim, "forces", None)
+        if self.forces is None:
+            self.run_batch = _sim_run_batch(sim, K)
+        else:  # iso15066: the reward needs the force ratio at every action end, so episodes are stepped
+            self.metrics = self._iso_metrics
 
     def metrics(self, rows) -> tuple[float, float]:
         last = rows[-1]
         return float(last[self._d]), float(last[self._v])
+
+    def _iso_metrics(self, rows) -> tuple[float, float, float]:
+        """(d_HR, v_R, predicted force / transient limit) at the action's last step (see ``IsoReward``)."""
+        last = rows[-1]
+        return float(last[self._d]), float(last[self._v]), float(self.forces.assess(last).ratio)
+
+
+def make_reward(sim):
+    """The reward of a simulator's criterion: the paper's (``Reward``) or ``IsoReward``."""
+    from cellstress.criteria import criterion_for
+
+    crit = criterion_for(sim.cell.spec.criterion)
+    if crit.name == "iso15066":
+        from cellstress.criteria.iso15066 import IsoReward
+
+        return IsoReward(sim.actions_per_episode)
+    return Reward(crit)
 
 
 class Reward:

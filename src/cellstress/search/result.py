@@ -56,9 +56,15 @@ class SearchResult:
     risk_per_episode: list[float]  # max 1/c_S of each episode
     version: str
     format: int = FORMAT
+    # distinct mode only (absent from the file otherwise): the first hazard of each class, in the order found:
+    # {class, episode, actions, step, time_s, robot_link, body_part, v_R, trace}
+    distinct: list[dict[str, Any]] | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        return json_ready(asdict(self))
+        doc = asdict(self)
+        if doc["distinct"] is None:
+            del doc["distinct"]
+        return json_ready(doc)
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), sort_keys=True, indent=1, allow_nan=False) + "\n"

@@ -62,12 +62,14 @@ class Tree:
         self.seed = int(seed)
         self.ec, self.k, self.alpha = float(ec), float(k), float(alpha)
         self.horizon = problem.actions_per_episode
+        self.revisit = getattr(problem, "revisit", None)
         self.rollout_rng = np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(ROLLOUT_KEY,)))
         self.root = Node(problem.reset(), (), 0.0, 0.0, bool(problem.is_unsafe(problem.reset())))
 
     def _widen(self, node: Node) -> None:
         if node.untried is None:
-            node.untried = list(range(self.problem.n_actions))
+            choices = getattr(self.problem, "choices", None)  # e.g. the start points at the root
+            node.untried = list(range(self.problem.n_actions if choices is None else choices(node.depth)))
             node.rng = np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=(NODE_KEY, *node.path)))
         a = node.untried.pop(int(node.rng.integers(len(node.untried))))
         node.edges[a] = Edge()
@@ -110,6 +112,8 @@ class Tree:
             if new:
                 edge.child = self._expand(node, a)
             node = edge.child
+            if not new and node.unsafe and self.revisit is not None:  # e.g. distinct mode: a known hazard
+                self.revisit(node)
             actions.append(a)
             ret += node.r
             risk = max(risk, node.risk)

@@ -75,7 +75,8 @@ def build_layout(cell: Cell) -> Layout:
     scal[K.C_CYCLE] = traj.cycle
     scal[K.C_DWELL] = traj.dwell
     scal[K.C_DTOL] = spec.criterion.distance_tolerance
-    scal[K.C_VTOL] = spec.criterion.speed_tolerance
+    # iso15066: the kernel latches no contact (it may be safe); the Simulator applies the force criterion
+    scal[K.C_VTOL] = spec.criterion.speed_tolerance if spec.criterion.type == "contact-while-moving" else np.inf
     scal[K.C_REACH_ORIGIN] = reach.origin
     scal[K.C_REACH_H] = reach.spacing
 

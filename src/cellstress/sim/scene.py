@@ -92,3 +92,44 @@ def reach_points(layout: Layout, pose: BodyPose, side: int, stride: int = 1,
     _detour_within(P.fences, W.near, n_near, np.ascontiguousarray(pose.shoulders[side]), np.ascontiguousarray(pts),
                    float(P.body[K.B_ARM_LEN]), keep)
     return pts[keep]
+
+
+def joint_state(layout: Layout, row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The robot's joint positions and velocities (q, q_dot) at a metric row, from the kernel's own trajectory.
+
+    The row holds the path time tau and the stop phase; while braking, the time since the stop took effect
+    follows from tau = tau0 + t_s + d - d^2 / (2 T) with t = t_s + d, so the time-scaling sigma = 1 - d / T."""
+    P = layout.params
+    T = float(P.scal[K.C_STOP_TIME])
+    tau, t, phase = float(row[K.M_TAU]), float(row[K.M_T]), int(row[K.M_PHASE])
+    if phase == K.PHASE_STOPPED:
+        sigma = 0.0
+    elif phase == K.PHASE_BRAKING:
+        d = float(np.sqrt(max(0.0, 2.0 * T * (t + float(P.scal[K.C_PHASE0]) - tau))))
+        sigma = max(0.0, 1.0 - d / T)
+    else:
+        sigma = 1.0
+    nj = P.placements.shape[0]
+    q, qd = np.zeros(nj), np.zeros(nj)
+    K.joint_trajectory(P, tau, sigma, q, qd)
+    return q, qd
+
+
+def contact_normal(layout: Layout, row: np.ndarray, pose: BodyPose) -> np.ndarray:
+    """Unit normal from the robot towards the human at a row's closest points: between the capsule axes for a
+    body capsule (defined also when they overlap), from the robot point towards the shoulder for a reach volume
+    (as the kernel places the points)."""
+    part, link = int(row[K.M_PART]), int(row[K.M_LINK])
+    rp = np.asarray(row[K.M_RX:K.M_RZ + 1], dtype=float)
+    if part >= N_CAPSULES:
+        v = pose.shoulders[part - N_CAPSULES] - rp
+    else:
+        ra, rb = robot_capsules(layout, float(row[K.M_TAU]))
+        c1, c2 = np.zeros(3), np.zeros(3)
+        K.segment_segment(np.ascontiguousarray(ra[link]), np.ascontiguousarray(rb[link]),
+                          np.ascontiguousarray(pose.a[part]), np.ascontiguousarray(pose.b[part]), c1, c2)
+        v = c2 - c1
+        if float(np.linalg.norm(v)) <= 1e-9:
+            v = np.asarray(row[K.M_HX:K.M_HZ + 1], dtype=float) - rp
+    n = float(np.linalg.norm(v))
+    return v / n if n > 1e-12 else np.array([0.0, 0.0, 1.0])

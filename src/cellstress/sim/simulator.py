@@ -112,6 +112,14 @@ class Simulator:
                       self._s0, self._work, self._row0)
         self._s0.setflags(write=False)
         self._rows = np.zeros((self.params.spa, K.NM))
+        self.forces = _force_model(self.layout)
+
+    @property
+    def criterion(self):
+        """The cell's criterion object (``ContactWhileMoving`` or ``Iso15066``)."""
+        from cellstress.criteria import criterion_for
+
+        return criterion_for(self.cell.spec.criterion)
 
     def with_start(self, start: tuple[float, float, float]) -> Simulator:
         """The same cell with another start pose (x, y, heading_deg); shares this simulator's set-up."""
@@ -151,7 +159,14 @@ class Simulator:
         a = action if type(action) is int and 0 <= action < N_ACTIONS else action_index(action)
         nxt = state.copy()
         n = K.step_action(self.params, nxt, a, self._work, self._rows, 0)
-        return nxt, self._rows[:n].copy()
+        rows = self._rows[:n].copy()
+        if self.forces is not None and n:
+            i = self.forces.first_unsafe(rows)
+            if i is not None:  # the criterion's unsafe step ends the episode there, as the kernel's would
+                rows = rows[:i + 1]
+                rows[i, K.M_UNSAFE] = 1.0
+                nxt[K.S_UNSAFE] = 1.0
+        return nxt, rows
 
     @staticmethod
     def is_unsafe(state: np.ndarray) -> bool:
@@ -171,8 +186,22 @@ class Simulator:
 
     # ---- episodes ---------------------------------------------------------------------------------------
     def run(self, actions) -> Trace:
-        """Play a whole action sequence from s0 (stopping at the first unsafe step)."""
+        """Play a whole action sequence from s0 (stopping at the first unsafe step). A leading ``start:NAME``
+        plays it from that start point of the cell's ``human.starts`` (see ``search.multistart``)."""
+        if len(actions) and isinstance(actions[0], str) and actions[0].startswith("start:"):
+            from cellstress.search.multistart import split_start
+
+            sim, rest = split_start(self, actions)
+            return sim.run(rest)
         acts = np.asarray([action_index(a) for a in actions], dtype=np.int64)
+        if self.forces is not None:  # step by step, so that the criterion ends the episode
+            state, parts = self.reset(), [self._row0[None, :].copy()]
+            for a in acts:
+                state, rows = self.step(state, int(a))
+                parts.append(rows)
+                if self.is_unsafe(state):
+                    break
+            return Trace(np.concatenate(parts), tuple(int(a) for a in acts), self.layout)
         out = np.zeros((1 + len(acts) * self.params.spa, K.NM))
         n = K.run_episode(self.params, self._s0, acts, out)
         return Trace(out[:n], tuple(int(a) for a in acts), self.layout)
@@ -188,4 +217,29 @@ class Simulator:
         unsafe_step = np.empty(n_ep, dtype=np.int64)
         min_d = np.empty(n_ep)
         K.run_batch(self.params, self._s0, acts, d_end, v_end, unsafe_step, min_d)
+        if self.forces is not None:
+            # contacts are rare: replay the episodes that touched, one by one, with the force criterion
+            spa = self.params.spa
+            for e in np.flatnonzero(min_d <= self.forces.crit.distance_tolerance):
+                rows = self.run(acts[e]).rows
+                if rows[-1, K.M_UNSAFE] == 0.0:
+                    continue
+                last = int(rows[-1, K.M_STEP])
+                unsafe_step[e] = last
+                played = -(-last // spa)
+                d_end[e, played - 1], v_end[e, played - 1] = rows[-1, K.M_D], rows[-1, K.M_V]
+                d_end[e, played:] = np.nan
+                v_end[e, played:] = np.nan
+                min_d[e] = rows[1:, K.M_D].min()
         return BatchResult(d_end, v_end, unsafe_step, min_d)
+
+
+def _force_model(layout: Layout):
+    """The force model of an ``iso15066`` cell, else None (the kernel applies contact-while-moving itself)."""
+    spec = layout.cell.spec.criterion
+    if spec.type != "iso15066":
+        return None
+    from cellstress.criteria import criterion_for
+    from cellstress.criteria.iso15066 import ForceModel
+
+    return ForceModel(layout, criterion_for(spec))
