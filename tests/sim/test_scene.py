@@ -51,9 +51,8 @@ def test_reach_points_are_inside_the_kernels_reach_volume():
     assert n_near > 0  # S3's contact is made around a fence end: the detour test is exercised
     side = 0 if r["body_part"] == "left-reach" else 1
     pts = scene.reach_points(sim.layout, pose, side)
-    local = np.zeros(3)
     sample = pts[np.random.default_rng(0).integers(0, len(pts), 500)]
-    assert max(K.reach_value(P, p.copy(), side, W, n_near, local) for p in sample) <= 1e-6
+    assert max(K.reach_value(P, p.copy(), side, W, n_near) for p in sample) <= 1e-6
     # the contact point is on the volume: a node lies within one grid diagonal of it
     h = sim.layout.reach.spacing
     assert np.linalg.norm(pts - np.asarray(r["robot_point"]), axis=1).min() < h * math.sqrt(3)

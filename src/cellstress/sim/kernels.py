@@ -15,6 +15,7 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
+from numba.typed import List
 
 from cellstress.sim.geometry import (
     point_segment_2d,
@@ -136,7 +137,7 @@ def path_time(scal, t, t_stop):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def joint_trajectory(scal, seg_start, seg_move, wp, tau, sigma, q, qd):
+def _joint_trajectory(scal, seg_start, seg_move, wp, tau, sigma, q, qd):
     """Joint positions and velocities on the cyclic minimum-jerk path at path time tau."""
     cycle = scal[C_CYCLE]
     dwell = scal[C_DWELL]
@@ -167,7 +168,7 @@ def joint_trajectory(scal, seg_start, seg_move, wp, tau, sigma, q, qd):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def forward_kinematics(parents, placements, base, axes, q, rot, pos):
+def _forward_kinematics(parents, placements, base, axes, q, rot, pos):
     """World rotation and origin of every joint frame."""
     nj = q.shape[0]
     m = np.empty((3, 3))
@@ -203,7 +204,7 @@ def forward_kinematics(parents, placements, base, axes, q, rot, pos):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def fastest_joint_speed(anc, axes, qd, rot, pos):
+def _fastest_joint_speed(anc, axes, qd, rot, pos):
     """v_R: the largest Cartesian speed of any joint origin (the paper's 'fastest robot joint')."""
     nj = qd.shape[0]
     best = 0.0
@@ -226,7 +227,7 @@ def fastest_joint_speed(anc, axes, qd, rot, pos):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def robot_capsules(cap_joint, cap_a, cap_b, base, rot, pos, ra, rb):
+def _robot_capsules(cap_joint, cap_a, cap_b, base, rot, pos, ra, rb):
     for c in range(cap_joint.shape[0]):
         j = cap_joint[c]
         for r in range(3):
@@ -245,10 +246,31 @@ def robot_live(P, t, t_stop, W):
     """Pose the robot at time t: capsules into W.ra/W.rb. Returns (v_R, stop phase, path time)."""
     tau, sigma, phase = path_time(P.scal, t, t_stop)
     q, qd, rot, pos = W.q, W.qd, W.rot, W.pos
-    joint_trajectory(P.scal, P.seg_start, P.seg_move, P.wp, tau, sigma, q, qd)
-    forward_kinematics(P.parents, P.placements, P.base, P.axes, q, rot, pos)
-    robot_capsules(P.cap_joint, P.cap_a, P.cap_b, P.base, rot, pos, W.ra, W.rb)
-    return fastest_joint_speed(P.anc, P.axes, qd, rot, pos), phase, tau
+    _joint_trajectory(P.scal, P.seg_start, P.seg_move, P.wp, tau, sigma, q, qd)
+    _forward_kinematics(P.parents, P.placements, P.base, P.axes, q, rot, pos)
+    _robot_capsules(P.cap_joint, P.cap_a, P.cap_b, P.base, rot, pos, W.ra, W.rb)
+    return _fastest_joint_speed(P.anc, P.axes, qd, rot, pos), phase, tau
+
+
+# The same with SimParams / Work, for callers outside the hot loop (tests, scene, the ISO check).
+@njit(cache=True, error_model="numpy")
+def joint_trajectory(P, tau, sigma, q, qd):
+    _joint_trajectory(P.scal, P.seg_start, P.seg_move, P.wp, tau, sigma, q, qd)
+
+
+@njit(cache=True, error_model="numpy")
+def forward_kinematics(P, q, rot, pos):
+    _forward_kinematics(P.parents, P.placements, P.base, P.axes, q, rot, pos)
+
+
+@njit(cache=True, error_model="numpy")
+def fastest_joint_speed(P, qd, rot, pos):
+    return _fastest_joint_speed(P.anc, P.axes, qd, rot, pos)
+
+
+@njit(cache=True, error_model="numpy")
+def robot_capsules(P, rot, pos, ra, rb):
+    _robot_capsules(P.cap_joint, P.cap_a, P.cap_b, P.base, rot, pos, ra, rb)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -447,7 +469,7 @@ def reach_args(P, W):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def reach_value(reach, origin, h, arm_len, fences, near, sh, tr, side, n_near, px, py, pz):
+def _reach_value(reach, origin, h, arm_len, fences, near, sh, tr, side, n_near, px, py, pz):
     """Signed distance from p to the reach volume of arm ``side`` (0 left, 1 right), fences respected."""
     s0, s1, s2 = sh[side, 0], sh[side, 1], sh[side, 2]
     dx, dy, dz = px - s0, py - s1, pz - s2
@@ -483,6 +505,13 @@ def collect_near_fences(fences, sh, near, margin):
     return n
 
 
+@njit(cache=True, error_model="numpy")
+def reach_value(P, p, side, W, n_near):
+    """Signed distance from point p to the reach volume of arm ``side`` at the pose in W (outside the hot loop)."""
+    return _reach_value(P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], P.body[B_ARM_LEN], P.fences, W.near,
+                        W.sh, W.tr, side, n_near, p[0], p[1], p[2])
+
+
 @njit(cache=True, error_model="numpy", inline="always")
 def reach_to_segment(reach, origin, h, arm_len, fences, near, sh, tr, side, n_near,
                      ax, ay, az, bx, by, bz, r, bound, out_q):
@@ -498,7 +527,7 @@ def reach_to_segment(reach, origin, h, arm_len, fences, near, sh, tr, side, n_ne
     while True:
         tt = t / L if L > 0.0 else 0.0
         px, py, pz = ax + tt * (bx - ax), ay + tt * (by - ay), az + tt * (bz - az)
-        f = reach_value(reach, origin, h, arm_len, fences, near, sh, tr, side, n_near, px, py, pz)
+        f = _reach_value(reach, origin, h, arm_len, fences, near, sh, tr, side, n_near, px, py, pz)
         if f < best:
             best = f
             out_q[0], out_q[1], out_q[2] = px, py, pz
@@ -643,7 +672,7 @@ def separation(P, W, n_near, row):
         t = ts[m]
         px, py, pz = ra[c, 0] + t * (rb[c, 0] - ra[c, 0]), ra[c, 1] + t * (rb[c, 1] - ra[c, 1]), \
             ra[c, 2] + t * (rb[c, 2] - ra[c, 2])
-        d = reach_value(A.reach, A.origin, A.h, A.arm_len, A.fences, A.near, A.sh, A.tr, side, n_near,
+        d = _reach_value(A.reach, A.origin, A.h, A.arm_len, A.fences, A.near, A.sh, A.tr, side, n_near,
                         px, py, pz) - r
         if d < best:
             best, best_cap, best_part = d, c, PART_LEFT_REACH + side
@@ -860,3 +889,20 @@ def run_batch(P, s0, actions, d_end, v_end, unsafe_step, min_d):
                     v_end[e, kk] = np.nan
                 break
         min_d[e] = lo
+
+
+# ---- one action at a time from Python ---------------------------------------------------------------------
+# Calling a compiled function types every argument: SimParams and Work hold about 50 arrays, which costs
+# ~9 us per call, more than an action's physics. A typed list holding both is typed in one look-up.
+@njit(cache=True)
+def make_handle(P, W):
+    h = List()
+    h.append((P, W))
+    return h
+
+
+@njit(cache=True, error_model="numpy")
+def step_with_handle(h, state, action, out):
+    """step_action(P, state, action, W, out, 0) for the (P, W) in handle h."""
+    P, W = h[0]
+    return step_action(P, state, action, W, out, 0)

@@ -15,6 +15,7 @@ from numba import njit
 from cellstress.human.body import BODY_PARTS, N_CAPSULES
 from cellstress.sim import kernels as K
 from cellstress.sim.build import Layout
+from cellstress.sim.geometry import segment_segment
 
 
 @dataclass(frozen=True, eq=False)
@@ -126,7 +127,7 @@ def contact_normal(layout: Layout, row: np.ndarray, pose: BodyPose) -> np.ndarra
     else:
         ra, rb = robot_capsules(layout, float(row[K.M_TAU]))
         c1, c2 = np.zeros(3), np.zeros(3)
-        K.segment_segment(np.ascontiguousarray(ra[link]), np.ascontiguousarray(rb[link]),
+        segment_segment(np.ascontiguousarray(ra[link]), np.ascontiguousarray(rb[link]),
                           np.ascontiguousarray(pose.a[part]), np.ascontiguousarray(pose.b[part]), c1, c2)
         v = c2 - c1
         if float(np.linalg.norm(v)) <= 1e-9:

@@ -102,6 +102,7 @@ class Simulator:
             self.layout = build_layout(cell)
         self.params = self.layout.params
         self._work = K.make_work(self.params)
+        self._handle = K.make_handle(self.params, self._work)
         if start is None:
             s = cell.spec.human.start
             start = (s.xy[0], s.xy[1], s.heading_deg)
@@ -158,7 +159,7 @@ class Simulator:
         """Play one action from ``state``: (next state, metric rows of its time steps)."""
         a = action if type(action) is int and 0 <= action < N_ACTIONS else action_index(action)
         nxt = state.copy()
-        n = K.step_action(self.params, nxt, a, self._work, self._rows, 0)
+        n = K.step_with_handle(self._handle, nxt, a, self._rows)
         rows = self._rows[:n].copy()
         if self.forces is not None and n:
             i = self.forces.first_unsafe(rows)
