@@ -7,6 +7,11 @@ move the worker -> sense (devices latch a stop) -> move the robot -> measure.
 The robot is a pure function of time and of the moment its stop takes effect: its path time advances one
 second per second until the stop, then slows linearly to a standstill within the stopping time, so
 tau(t) = t_s + d - d^2 / (2 T) for d = t - t_s < T. Nothing is integrated, so nothing drifts.
+
+Speed: numba reference-counts arrays, and passing a tuple of arrays (SimParams, Work) into an inlined function
+increments and decrements every member, atomically. On the hot path that bookkeeping once took two thirds of
+the run time. So the inlined helpers take the arrays they read (and scalars, and index rows element-wise
+rather than slicing views); only the entry points take SimParams and Work.
 """
 
 from __future__ import annotations
@@ -104,6 +109,7 @@ class Work(NamedTuple):
     best_h: np.ndarray
     lbs: np.ndarray
     ts: np.ndarray
+    stopped: np.ndarray  # (2,) t_stop, v_R of the standstill pose held in ra/rb, or NaN (see robot_at)
 
 
 @njit(cache=True, error_model="numpy")
@@ -116,7 +122,7 @@ def make_work(P):
         np.zeros((N_BODY_CAPSULES, 3)), np.zeros((N_BODY_CAPSULES, 3)), np.zeros(N_BODY_CAPSULES),
         np.zeros((2, 3)), np.zeros((3, 3)), np.zeros(P.fences.shape[0] + 1, dtype=np.int64),
         np.zeros(3), np.zeros(3), np.zeros((4, 3)), np.zeros(3), np.zeros(3),
-        np.zeros(2 * nc), np.zeros(2 * nc),
+        np.zeros(2 * nc), np.zeros(2 * nc), np.full(2, np.nan),
     )
 
 
@@ -244,12 +250,19 @@ def _robot_capsules(cap_joint, cap_a, cap_b, base, rot, pos, ra, rb):
 @njit(cache=True, error_model="numpy")
 def robot_live(P, t, t_stop, W):
     """Pose the robot at time t: capsules into W.ra/W.rb. Returns (v_R, stop phase, path time)."""
-    tau, sigma, phase = path_time(P.scal, t, t_stop)
-    q, qd, rot, pos = W.q, W.qd, W.rot, W.pos
-    _joint_trajectory(P.scal, P.seg_start, P.seg_move, P.wp, tau, sigma, q, qd)
-    _forward_kinematics(P.parents, P.placements, P.base, P.axes, q, rot, pos)
-    _robot_capsules(P.cap_joint, P.cap_a, P.cap_b, P.base, rot, pos, W.ra, W.rb)
-    return _fastest_joint_speed(P.anc, P.axes, qd, rot, pos), phase, tau
+    W.stopped[0] = np.nan
+    return _robot_live(P.scal, P.seg_start, P.seg_move, P.wp, P.parents, P.placements, P.base, P.axes, P.anc,
+                       P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot, W.pos, W.ra, W.rb, t, t_stop)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _robot_live(scal, seg_start, seg_move, wp, parents, placements, base, axes, anc, cap_joint, cap_a, cap_b,
+                q, qd, rot, pos, ra, rb, t, t_stop):
+    tau, sigma, phase = path_time(scal, t, t_stop)
+    _joint_trajectory(scal, seg_start, seg_move, wp, tau, sigma, q, qd)
+    _forward_kinematics(parents, placements, base, axes, q, rot, pos)
+    _robot_capsules(cap_joint, cap_a, cap_b, base, rot, pos, ra, rb)
+    return _fastest_joint_speed(anc, axes, qd, rot, pos), phase, tau
 
 
 # The same with SimParams / Work, for callers outside the hot loop (tests, scene, the ISO check).
@@ -276,17 +289,30 @@ def robot_capsules(P, rot, pos, ra, rb):
 @njit(cache=True, error_model="numpy", inline="always")
 def robot_at(P, k, t_stop, W):
     """The robot at step k. Until a stop takes effect every episode moves the robot identically, so those
-    steps come from a table made once per cell by the same code (bit-identical to computing them)."""
-    t = k * P.scal[C_DT]
+    steps come from a table made once per cell by the same code (bit-identical to computing them). Once the
+    robot stands, its pose no longer changes: W.stopped = (t_stop, v_R) marks that W.ra/W.rb hold the
+    standstill pose for that stop (NaN: they do not)."""
+    scal, ra, rb, stopped = P.scal, W.ra, W.rb, W.stopped
+    t = k * scal[C_DT]
     pre_v = P.pre_v
     if t < t_stop and k < pre_v.shape[0]:
-        pre_ra, pre_rb, ra, rb = P.pre_ra, P.pre_rb, W.ra, W.rb
+        pre_ra, pre_rb = P.pre_ra, P.pre_rb
         for c in range(ra.shape[0]):
             for r in range(3):
                 ra[c, r] = pre_ra[k, c, r]
                 rb[c, r] = pre_rb[k, c, r]
+        stopped[0] = np.nan
         return pre_v[k], (PHASE_RUNNING if t_stop == np.inf else PHASE_PENDING), P.pre_tau[k]
-    return robot_live(P, t, t_stop, W)
+    if stopped[0] == t_stop and t - t_stop >= scal[C_STOP_TIME]:
+        tau, _, phase = path_time(scal, t, t_stop)
+        return stopped[1], phase, tau
+    v, phase, tau = _robot_live(scal, P.seg_start, P.seg_move, P.wp, P.parents, P.placements, P.base, P.axes,
+                                P.anc, P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot, W.pos, ra, rb, t, t_stop)
+    if phase == PHASE_STOPPED:
+        stopped[0], stopped[1] = t_stop, v
+    else:
+        stopped[0] = np.nan
+    return v, phase, tau
 
 
 @njit(cache=True, error_model="numpy")
@@ -308,7 +334,7 @@ def human_pose(P, x, y, heading, fwd, lat, W):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def pose_body(b, x, y, heading, fwd, lat, ha, hb, hr, sh, tr):
-    """human_pose on the arrays themselves (the hot path; see ReachArgs for why)."""
+    """human_pose on the arrays themselves (the hot path: see the module docstring)."""
     ch, shh = np.cos(heading), np.sin(heading)
     cf, sf = np.cos(fwd), np.sin(fwd)
     cl, sl = np.cos(lat), np.sin(lat)
@@ -445,27 +471,6 @@ def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz):
                     and _path_clear(fences, near, n_near, ex, ey, ez, qx, qy, qz)):
                 best = length
     return best
-
-
-class ReachArgs(NamedTuple):
-    """What the reach queries read, gathered once per step. (The hot loops get these few arrays and scalars
-    rather than SimParams and Work: numba reference-counts every array of a tuple passed along, and on this
-    path that bookkeeping cost more than the geometry.)"""
-
-    reach: np.ndarray
-    origin: float
-    h: float
-    arm_len: float
-    fences: np.ndarray
-    near: np.ndarray
-    sh: np.ndarray
-    tr: np.ndarray
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def reach_args(P, W):
-    return ReachArgs(P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], P.body[B_ARM_LEN], P.fences, W.near,
-                     W.sh, W.tr)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -627,7 +632,8 @@ def _set_reach_hit(row, q):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def separation(P, W, n_near, row):
+def separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
+               n_near, row):
     """d_HR: minimum distance between the robot capsules and the body capsules or reach volumes.
 
     Reach volumes first, nearest (capsule, arm) pair first: they usually hold the minimum, and the bound
@@ -638,14 +644,10 @@ def separation(P, W, n_near, row):
     best = np.inf
     best_cap = -1
     best_part = -1
-    ra, rb, sh = W.ra, W.rb, W.sh
-    q = W.best_r
-    nc = P.cap_r.shape[0]
+    nc = cap_r.shape[0]
     # Reach volumes lie inside the arm-length ball around their shoulder, so |p - s| - L bounds the distance
     # from below. Visit (capsule, arm) pairs from the smallest bound up; stop when the bound passes the best.
-    L = P.body[B_ARM_LEN] + 2.0 * P.scal[C_REACH_H]
-    lbs = W.lbs
-    ts = W.ts
+    L = arm_len + 2.0 * grid_h
     for c in range(nc):
         abx, aby, abz = rb[c, 0] - ra[c, 0], rb[c, 1] - ra[c, 1], rb[c, 2] - ra[c, 2]
         ll = abx * abx + aby * aby + abz * abz
@@ -654,9 +656,8 @@ def separation(P, W, n_near, row):
             t = 0.0 if ll <= 0.0 else (sx * abx + sy * aby + sz * abz) / ll
             t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
             px, py, pz = t * abx - sx, t * aby - sy, t * abz - sz
-            lbs[2 * c + side] = np.sqrt(px * px + py * py + pz * pz) - P.cap_r[c] - L
+            lbs[2 * c + side] = np.sqrt(px * px + py * py + pz * pz) - cap_r[c] - L
             ts[2 * c + side] = t
-    A = reach_args(P, W)
     while True:
         m = -1
         lo = best
@@ -668,11 +669,11 @@ def separation(P, W, n_near, row):
             break
         lbs[m] = np.inf
         c, side = m // 2, m % 2
-        r = P.cap_r[c]
+        r = cap_r[c]
         t = ts[m]
         px, py, pz = ra[c, 0] + t * (rb[c, 0] - ra[c, 0]), ra[c, 1] + t * (rb[c, 1] - ra[c, 1]), \
             ra[c, 2] + t * (rb[c, 2] - ra[c, 2])
-        d = _reach_value(A.reach, A.origin, A.h, A.arm_len, A.fences, A.near, A.sh, A.tr, side, n_near,
+        d = _reach_value(reach, origin, grid_h, arm_len, fences, near, sh, tr, side, n_near,
                         px, py, pz) - r
         if d < best:
             best, best_cap, best_part = d, c, PART_LEFT_REACH + side
@@ -696,7 +697,7 @@ def separation(P, W, n_near, row):
         t1 = 1.0 if t1 > 1.0 else t1
         if t1 <= t0:
             continue
-        d = reach_to_segment(A.reach, A.origin, A.h, A.arm_len, A.fences, A.near, A.sh, A.tr, side, n_near,
+        d = reach_to_segment(reach, origin, grid_h, arm_len, fences, near, sh, tr, side, n_near,
                              ra[c, 0] + t0 * (rb[c, 0] - ra[c, 0]), ra[c, 1] + t0 * (rb[c, 1] - ra[c, 1]),
                              ra[c, 2] + t0 * (rb[c, 2] - ra[c, 2]), ra[c, 0] + t1 * (rb[c, 0] - ra[c, 0]),
                              ra[c, 1] + t1 * (rb[c, 1] - ra[c, 1]), ra[c, 2] + t1 * (rb[c, 2] - ra[c, 2]),
@@ -704,9 +705,8 @@ def separation(P, W, n_near, row):
         if d < best:
             best, best_cap, best_part = d, c, PART_LEFT_REACH + side
             _set_reach_hit(row, q)
-    ha, hb, hr = W.ha, W.hb, W.hr
     for c in range(nc):
-        r = P.cap_r[c]
+        r = cap_r[c]
         mx, my, mz = 0.5 * (ra[c, 0] + rb[c, 0]), 0.5 * (ra[c, 1] + rb[c, 1]), 0.5 * (ra[c, 2] + rb[c, 2])
         half = 0.5 * np.sqrt((rb[c, 0] - ra[c, 0]) ** 2 + (rb[c, 1] - ra[c, 1]) ** 2 + (rb[c, 2] - ra[c, 2]) ** 2)
         for h in range(N_BODY_CAPSULES):
@@ -726,12 +726,12 @@ def separation(P, W, n_near, row):
                 row[M_HX], row[M_HY], row[M_HZ] = c2x, c2y, c2z
     # surface points: step from the axis points towards each other by the radii
     if best_part >= PART_LEFT_REACH:
-        s = W.sh[best_part - PART_LEFT_REACH]
+        s = sh[best_part - PART_LEFT_REACH]
         dx, dy, dz = s[0] - row[M_RX], s[1] - row[M_RY], s[2] - row[M_RZ]
         n = np.sqrt(dx * dx + dy * dy + dz * dz)
         if n > 0:
             dx, dy, dz = dx / n, dy / n, dz / n
-        r = P.cap_r[best_cap]
+        r = cap_r[best_cap]
         row[M_RX], row[M_RY], row[M_RZ] = row[M_RX] + r * dx, row[M_RY] + r * dy, row[M_RZ] + r * dz
         g = best if best > 0.0 else 0.0
         row[M_HX], row[M_HY], row[M_HZ] = row[M_RX] + g * dx, row[M_RY] + g * dy, row[M_RZ] + g * dz
@@ -740,7 +740,7 @@ def separation(P, W, n_near, row):
         n = np.sqrt(dx * dx + dy * dy + dz * dz)
         if n > 0:
             dx, dy, dz = dx / n, dy / n, dz / n
-        r, hr = P.cap_r[best_cap], W.hr[best_part]
+        r, hr = cap_r[best_cap], hr[best_part]
         row[M_RX], row[M_RY], row[M_RZ] = row[M_RX] + r * dx, row[M_RY] + r * dy, row[M_RZ] + r * dz
         row[M_HX], row[M_HY], row[M_HZ] = row[M_HX] - hr * dx, row[M_HY] - hr * dy, row[M_HZ] - hr * dz
     row[M_D] = best if best > 0.0 else 0.0
@@ -770,11 +770,16 @@ def sense_and_measure(P, state, W, row, action):
                     state[S_TRIG_T] = t
                 state[S_TRIG_DEV] = d
     v, phase, tau = robot_at(P, int(k), state[S_TSTOP], W)
+    cap_r, reach, origin, grid_h, arm_len, fences = P.cap_r, P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], \
+        P.body[B_ARM_LEN], P.fences
+    ra, rb, near, lbs, ts, q = W.ra, W.rb, W.near, W.lbs, W.ts, W.best_r
     if n_near == 0:
         # the common case, compiled separately so that the fence-detour code drops out of it
-        d_hr = separation(P, W, 0, row)
+        d_hr = separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
+                          0, row)
     else:
-        d_hr = separation(P, W, n_near, row)
+        d_hr = separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
+                          n_near, row)
     unsafe = d_hr <= P.scal[C_DTOL] and v > P.scal[C_VTOL]
     row[M_T] = t
     row[M_X], row[M_Y], row[M_HEADING] = state[S_X], state[S_Y], state[S_HEADING]
