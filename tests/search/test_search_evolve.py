@@ -36,14 +36,17 @@ def test_evolve_beats_random_on_the_toy_walk_in_milliseconds() -> None:
     spent = time.perf_counter() - t0
     # random needs about 5 right actions in a row (p ~ 6**-5 per episode): a median near 1000 episodes
     assert statistics.median(rnd) > 600
-    assert statistics.median(evo) * 5 < statistics.median(rnd)  # measured: 95 against 977
-    assert max(evo) < 1000
+    assert statistics.median(evo) * 5 < statistics.median(rnd)  # measured: 117 against 977
+    assert max(evo) < 1500  # measured 1039: the restart after 100 episodes without progress
+    # without restarts, hill climbing can stall for good on this walk
+    stalled = [episodes_to_hazard("evolve", s, budget, patience=0) for s in SEEDS]
+    assert budget in stalled
     assert spent < 2.0  # 15 searches; a few ms each
 
 
 def test_evolve_options_still_beat_random() -> None:
     # on the toy the scores coincide (no stop phase: "running" falls back to the risk); restarts hurt here
-    for options in ({"score": "risk"}, {"patience": 20}, {"sticky": 0.0, "keep_tail": 1.0}):
+    for options in ({"score": "risk"}, {"patience": 20}, {"sticky": 0.0, "keep_tail": 0.0}):
         evo = [episodes_to_hazard("evolve", s, 3000, **options) for s in SEEDS]
         assert statistics.median(evo) < 500, options
 
