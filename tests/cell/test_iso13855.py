@@ -129,8 +129,11 @@ def test_s2_fails_only_the_curtain(results):
     r = results["s2-elbow-intrusion"][1]
     assert r.failures() == ["bay-curtain"]
     curtain = r.devices[1]
-    assert curtain.actual == pytest.approx(0.796, abs=0.005) and curtain.actual < 1.17
+    assert curtain.actual == pytest.approx(0.985, abs=0.005) and curtain.actual < 1.17
     assert curtain.where.robot_part == "upper_arm_link"
+    # the folded elbow is the closest point, and an episode meets it (docs/cells.md, S2)
+    assert curtain.where.hazard_point[1] == pytest.approx(-0.615, abs=0.005)
+    assert curtain.episode_actual == pytest.approx(curtain.actual, abs=1e-3)
 
 
 def test_s3_fails_undetected_reach_at_the_gap(results):
@@ -154,8 +157,11 @@ def test_hazard_zone_covers_the_simulator_table(results):
         lo = np.minimum(P.pre_ra, P.pre_rb)[..., :2] - P.cap_r[None, :, None]
         hi = np.maximum(P.pre_ra, P.pre_rb)[..., :2] + P.cap_r[None, :, None]
         x0, x1, y0, y1 = r.zone.extent()
-        assert lo[..., 0].min() >= x0 - 1e-9 and hi[..., 0].max() <= x1 + 1e-9
-        assert lo[..., 1].min() >= y0 - 1e-9 and hi[..., 1].max() <= y1 + 1e-9
+        # hazard_zone drops poses equal to another within 1e-6 m (its repeat key), so the extent may differ by
+        # that much: S2 visits its fold pose twice per cycle, arriving from pick and from place
+        tol = 1e-6
+        assert lo[..., 0].min() >= x0 - tol and hi[..., 0].max() <= x1 + tol
+        assert lo[..., 1].min() >= y0 - tol and hi[..., 1].max() <= y1 + tol
 
 
 def test_static_check_lines(results):

@@ -1,4 +1,4 @@
-"""Search for hazards: ``random``, ``mcts`` (the paper's MCTS1) and ``mcts-commit`` (MCTS2).
+"""Search for hazards: ``random``, ``mcts`` (the paper's MCTS1), ``mcts-commit`` (MCTS2) and ``evolve`` (ours).
 
 One module per searcher over shared machinery (``common``: problem interface, reward, budget, top-k;
 ``tree``: the DPW tree; ``result``: the result record). ``search`` is the public entry point.
@@ -22,16 +22,17 @@ from cellstress.search.common import (
     Stop,
     check_common,
 )
+from cellstress.search.evolve import Evolve
 from cellstress.search.mcts import MCTS
 from cellstress.search.mcts_commit import MCTSCommit
 from cellstress.search.random_search import RandomSearch
 from cellstress.search.result import SearchResult
 
-SEARCHERS = {"random": RandomSearch, "mcts": MCTS, "mcts-commit": MCTSCommit}
+SEARCHERS = {"random": RandomSearch, "mcts": MCTS, "mcts-commit": MCTSCommit, "evolve": Evolve}
 DEFAULT_BUDGET = 200
 DEFAULT_TOP_K = 10
 
-__all__ = ["SEARCHERS", "UNTIL", "Episode", "MCTS", "MCTSCommit", "Outcome", "Problem", "RandomSearch",
+__all__ = ["SEARCHERS", "UNTIL", "Episode", "Evolve", "MCTS", "MCTSCommit", "Outcome", "Problem", "RandomSearch",
            "Recorder", "Reward", "SearchError", "SearchResult", "SimProblem", "make_searcher", "run_search",
            "search"]
 
@@ -66,8 +67,8 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
            top_k: int = DEFAULT_TOP_K, progress=None, distinct: bool = False, **options) -> SearchResult:
     """Search a cell (built-in name, path, ``Cell`` or ``Simulator``) for an unsafe action sequence.
 
-    ``searcher`` is ``random``, ``mcts`` or ``mcts-commit``; ``options`` are its parameters (see
-    ``MCTS``, ``MCTSCommit``, ``RandomSearch``). ``until="first"`` stops at the first hazard,
+    ``searcher`` is ``random``, ``mcts``, ``mcts-commit`` or ``evolve``; ``options`` are its parameters (see
+    ``MCTS``, ``MCTSCommit``, ``RandomSearch``, ``Evolve``). ``until="first"`` stops at the first hazard,
     ``until="budget"`` plays the whole budget. ``progress(episodes, best_risk)`` is called after each episode.
     ``distinct=True`` (with ``until="budget"``) clusters the hazards into classes and steers the search away
     from classes already found (``search.distinct``); the result lists each class's first hazard. A cell with
