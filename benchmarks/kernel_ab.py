@@ -1,0 +1,54 @@
+"""A/B speed of two source trees of cellstress, interleaved in one run (fair on a noisy machine).
+
+    python benchmarks/kernel_ab.py OLD_SRC NEW_SRC [--cells baseline s3-fence-gap] [--episodes 20000]
+                                   [--rounds 3]
+
+OLD_SRC / NEW_SRC are folders holding a ``cellstress`` package (e.g. ``git archive HEAD~3 src | tar -x -C
+/tmp/old`` gives /tmp/old/src). Each measurement is a fresh process with one numba thread timing
+``run_batch`` (best CPU time of 3 calls after a warm-up); rounds alternate A and B. Prints the median
+episodes/s per tree and cell, and their ratio.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+
+CHILD = r"""
+import sys, time, numpy as np
+from cellstress.sim.simulator import Simulator
+sim = Simulator(sys.argv[1]); n = int(sys.argv[2])
+acts = np.random.default_rng(0).integers(0, 30, size=(n, sim.actions_per_episode))
+sim.run_batch(acts[:500])
+best = float("inf")
+for _ in range(3):
+    t0 = time.process_time(); sim.run_batch(acts); best = min(best, time.process_time() - t0)
+print(n / best)
+"""
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("old")
+    ap.add_argument("new")
+    ap.add_argument("--cells", nargs="+", default=["baseline", "s3-fence-gap"])
+    ap.add_argument("--episodes", type=int, default=20_000)
+    ap.add_argument("--rounds", type=int, default=3)
+    args = ap.parse_args(argv)
+    for cell in args.cells:
+        rates: dict[str, list[float]] = {args.old: [], args.new: []}
+        for _ in range(args.rounds):
+            for tree in (args.old, args.new):
+                env = dict(os.environ, PYTHONPATH=tree, NUMBA_NUM_THREADS="1")
+                out = subprocess.run([sys.executable, "-c", CHILD, cell, str(args.episodes)], env=env,
+                                     capture_output=True, text=True, check=True)
+                rates[tree].append(float(out.stdout.split()[-1]))
+        a, b = statistics.median(rates[args.old]), statistics.median(rates[args.new])
+        print(f"{cell:20s} old {a:9,.0f}  new {b:9,.0f} episodes/s (one thread)  new/old {b / a:.2f}")
+
+
+if __name__ == "__main__":
+    main()
