@@ -1,6 +1,6 @@
 """Search speed: episodes/s of each searcher on the reference cells (whole budget, ``until="budget"``).
 
-    python benchmarks/search_speed.py [--cells ...] [--searchers random mcts mcts-commit]
+    python benchmarks/search_speed.py [--cells ...] [--searchers random mcts ...]  (default: every searcher)
                                       [--budget 2000] [--repeats 5] [--threads 1]
 
 One episode = one iteration (reset to s0 and up to 8 actions). Per cell and searcher: median and min over the
@@ -16,14 +16,13 @@ import statistics
 import time
 
 CELLS = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap")
-SEARCHERS = ("random", "mcts", "mcts-commit")
 TARGET = 2_000.0
 
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cells", nargs="+", default=list(CELLS))
-    ap.add_argument("--searchers", nargs="+", default=list(SEARCHERS))
+    ap.add_argument("--searchers", nargs="+", default=None, help="default: every registered searcher")
     ap.add_argument("--budget", type=int, default=2000)
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--threads", type=int, default=1, help="numba threads (0: all cores)")
@@ -33,13 +32,13 @@ def main(argv=None) -> None:
 
     if args.threads:
         numba.set_num_threads(args.threads)
-    from cellstress.search import search
+    from cellstress.search import SEARCHERS, search
     from cellstress.sim.simulator import Simulator
 
     rows = []
     for cell in args.cells:
         sim = Simulator(cell)
-        for name in args.searchers:
+        for name in args.searchers or list(SEARCHERS):
             search(sim, name, budget=50, seed=0, until="budget")  # warm-up
             rates, found = [], 0
             for seed in range(args.repeats):
