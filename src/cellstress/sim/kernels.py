@@ -102,11 +102,7 @@ class Work(NamedTuple):
     sh: np.ndarray
     tr: np.ndarray
     near: np.ndarray
-    c1: np.ndarray
-    c2: np.ndarray
-    scratch: np.ndarray
     best_r: np.ndarray
-    best_h: np.ndarray
     lbs: np.ndarray
     ts: np.ndarray
     stopped: np.ndarray  # (2,) t_stop, v_R of the standstill pose held in ra/rb, or NaN (see robot_at)
@@ -121,7 +117,7 @@ def make_work(P):
         np.zeros((nc, 3)), np.zeros((nc, 3)),
         np.zeros((N_BODY_CAPSULES, 3)), np.zeros((N_BODY_CAPSULES, 3)), np.zeros(N_BODY_CAPSULES),
         np.zeros((2, 3)), np.zeros((3, 3)), np.zeros(P.fences.shape[0] + 1, dtype=np.int64),
-        np.zeros(3), np.zeros(3), np.zeros((4, 3)), np.zeros(3), np.zeros(3),
+        np.zeros(3),
         np.zeros(2 * nc), np.zeros(2 * nc), np.full(2, np.nan),
     )
 
