@@ -11,13 +11,12 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from cellstress.campaign.plan import MANIFEST, CampaignError, CampaignPlan, RunKey
-from cellstress.search.result import json_ready
+from cellstress.search.result import atomic_write, json_ready
 
 RUNS = "runs.jsonl"
 LOCK = ".campaign.lock"
@@ -72,23 +71,6 @@ def read_runs(path: Path, plan: CampaignPlan) -> Loaded:
                                 f"with a different outcome")
         records[key] = rec
     return Loaded(records, dropped)
-
-
-def atomic_write(path: Path, data: bytes) -> None:
-    """Replace ``path`` by ``data`` atomically (a crash leaves the old or the new file, never a mix)."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}-", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
 
 
 def rewrite_text(path: Path, text: str) -> None:

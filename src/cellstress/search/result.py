@@ -38,6 +38,23 @@ def json_ready(obj):
     raise TypeError(f"not JSON-ready: {type(obj).__name__}")
 
 
+def atomic_write(path: Path, data: bytes) -> None:
+    """Replace ``path`` by ``data`` atomically (a crash leaves the old or the new file, never a mix)."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}-", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+
+
 @dataclass(frozen=True)
 class SearchResult:
     """What ``cellstress.search`` returns and ``result.json`` holds."""
@@ -74,19 +91,7 @@ class SearchResult:
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         path = out / FILE_NAME
-        fd, tmp = tempfile.mkstemp(prefix=".result-", suffix=".json.tmp", dir=out)
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-                f.write(self.to_json())
-                f.flush()
-                os.fsync(f.fileno())
-            os.replace(tmp, path)
-        except BaseException:
-            try:
-                os.unlink(tmp)
-            except FileNotFoundError:
-                pass
-            raise
+        atomic_write(path, self.to_json().encode("utf-8"))
         return path
 
     @classmethod
