@@ -203,6 +203,9 @@ class StartSpec(_Record):
 
 class NamedStart(StartSpec):
     name: Annotated[str, Field(min_length=1, pattern=r"^[A-Za-z0-9_.-]+$")]
+    # the robot's path time [s] when a worker from this start point begins (the moment of the cycle at which
+    # they arrive); None: the cell's robot.task.phase
+    phase: NonNegative | None = None
 
 
 class HumanSpec(_Record):

@@ -27,6 +27,7 @@ from cellstress.search.mcts import MCTS
 from cellstress.search.mcts_commit import MCTSCommit
 from cellstress.search.random_search import RandomSearch
 from cellstress.search.result import SearchResult
+from cellstress.search.slices import SLICED
 
 SEARCHERS = {"random": RandomSearch, "mcts": MCTS, "mcts-commit": MCTSCommit, "evolve": Evolve}
 DEFAULT_BUDGET = 200
@@ -72,7 +73,9 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
     ``until="budget"`` plays the whole budget. ``progress(episodes, best_risk)`` is called after each episode.
     ``distinct=True`` (with ``until="budget"``) clusters the hazards into classes and steers the search away
     from classes already found (``search.distinct``); the result lists each class's first hazard. A cell with
-    several start points (``human.starts``) lets each episode's first decision pick one (``search.multistart``).
+    several start points (``human.starts``) lets each episode's first decision pick one (``search.multistart``);
+    with ``evolve`` the distinct mode instead shares the budget between the start points in slices
+    (``search.slices``).
     """
     from cellstress import __version__
     from cellstress.human.actions import ACTION_NAMES
@@ -94,13 +97,21 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
         problem = MultiStartProblem(sim)
         names = problem.names
     rec = None
-    if distinct:
-        from cellstress.search.distinct import DistinctProblem, DistinctRecorder, DistinctReward
+    if distinct and s.name in SLICED:  # whole-episode searchers: the budget in slices shared by the starts
+        from cellstress.search.slices import ClassRecorder, cell_starts, run_slices
 
-        problem = DistinctProblem(problem, sim, reward)
-        reward = DistinctReward(reward)
-        rec = DistinctRecorder(int(budget), until, int(top_k), progress, problem=problem)
-    out = run_search(problem, reward, s, budget, seed, until=until, top_k=top_k, progress=progress, recorder=rec)
+        starts = cell_starts(problem, reward)
+        rec = ClassRecorder(int(budget), until, int(top_k), progress, n_starts=len(starts))
+        out = run_slices(s, starts, reward, rec, int(seed))
+    else:
+        if distinct:
+            from cellstress.search.distinct import DistinctProblem, DistinctRecorder, DistinctReward
+
+            problem = DistinctProblem(problem, sim, reward)
+            reward = DistinctReward(reward)
+            rec = DistinctRecorder(int(budget), until, int(top_k), progress, problem=problem)
+        out = run_search(problem, reward, s, budget, seed, until=until, top_k=top_k, progress=progress,
+                         recorder=rec)
 
     if names is None:
         def names(actions):

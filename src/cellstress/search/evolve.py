@@ -102,12 +102,17 @@ class Evolve:
                 actions.append(draw(actions[-1] if actions else -1, -1))
             return actions
 
+        # distinct mode (search.slices): a hazard of a class already found is worth nothing, never a parent
+        known = getattr(problem, "known_hazard", None)
+
         def play(actions: list[int]) -> None:
             actions, steps, ret, risk, unsafe = player.play(actions)
             played.add(tuple(actions))
+            worthless = unsafe and known is not None and known(actions)
             for u, archive in archives.items():
                 s = [st[u] for st in steps]
-                archive.append((math.inf if unsafe else max(s, default=0.0), -len(archive), actions, s))
+                score = -math.inf if worthless else math.inf if unsafe else max(s, default=0.0)
+                archive.append((score, -len(archive), actions, s))
             rec.finish(actions, ret, risk, unsafe)  # raises Stop at the end
 
         def best_scores() -> list[float]:

@@ -19,7 +19,7 @@ class MultiStartProblem:
 
         self.sim = sim
         self.starts = sim.cell.spec.human.starts
-        self.sims = [sim.with_start((s.xy[0], s.xy[1], s.heading_deg)) for s in self.starts]
+        self.sims = [start_sim(sim, s) for s in self.starts]
         self.inner = [SimProblem(s) for s in self.sims]
         self.n_actions = sim.n_actions
         self.actions_per_episode = 1 + sim.actions_per_episode
@@ -53,6 +53,11 @@ class MultiStartProblem:
                 *(ACTION_NAMES[int(a)] for a in acts[1:])]
 
 
+def start_sim(sim, start):
+    """The simulator of one ``human.starts`` entry: its pose and, if it has one, its own robot phase."""
+    return sim.with_start((start.xy[0], start.xy[1], start.heading_deg), start.phase)
+
+
 def split_start(sim, actions):
     """(simulator for the leading ``start:NAME`` of ``actions`` or ``sim`` itself, the remaining actions)."""
     acts = list(actions)
@@ -63,6 +68,6 @@ def split_start(sim, actions):
     name = acts[0][len(START_PREFIX):]
     for s in sim.cell.spec.human.starts:
         if s.name == name:
-            return sim.with_start((s.xy[0], s.xy[1], s.heading_deg)), acts[1:]
+            return start_sim(sim, s), acts[1:]
     known = ", ".join(s.name for s in sim.cell.spec.human.starts) or "none"
     raise ActionError(f"unknown start {name!r} (the cell's starts: {known})")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -112,10 +113,29 @@ def build_layout(cell: Cell) -> Layout:
         pre_v=np.zeros(0),
         pre_tau=np.zeros(0),
     )
-    # the robot before any stop, for every step of an episode (and one spare action)
+    params = _with_robot_table(params, spec)
+    return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params)
+
+
+def _with_robot_table(params: K.SimParams, spec) -> K.SimParams:
+    """``params`` with the robot before any stop, for every step of an episode (and one spare action)."""
     n_pre = 1 + spec.simulation.steps_per_action * (spec.simulation.actions_per_episode + 1)
-    pre_ra, pre_rb = np.zeros((n_pre, len(caps), 3)), np.zeros((n_pre, len(caps), 3))
+    nc = params.cap_r.shape[0]
+    pre_ra, pre_rb = np.zeros((n_pre, nc, 3)), np.zeros((n_pre, nc, 3))
     pre_v, pre_tau = np.zeros(n_pre), np.zeros(n_pre)
     K.robot_table(params, n_pre, pre_ra, pre_rb, pre_v, pre_tau)
-    params = params._replace(pre_ra=pre_ra, pre_rb=pre_rb, pre_v=pre_v, pre_tau=pre_tau)
-    return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params)
+    return params._replace(pre_ra=pre_ra, pre_rb=pre_rb, pre_v=pre_v, pre_tau=pre_tau)
+
+
+def with_phase(layout: Layout, phase: float) -> Layout:
+    """The same cell with the robot's cycle at ``phase`` s when an episode starts (a start point's own
+    ``phase``): only the phase scalar and the robot table of the steps before any stop change."""
+    if float(phase) == float(layout.params.scal[K.C_PHASE0]):
+        return layout
+    scal = layout.params.scal.copy()
+    scal[K.C_PHASE0] = float(phase)
+    nc = layout.params.cap_r.shape[0]
+    bare = layout.params._replace(scal=scal, pre_ra=np.zeros((0, nc, 3)), pre_rb=np.zeros((0, nc, 3)),
+                                  pre_v=np.zeros(0), pre_tau=np.zeros(0))  # as build_layout computes it
+    params = _with_robot_table(bare, layout.cell.spec)
+    return dataclasses.replace(layout, params=params)

@@ -122,9 +122,19 @@ class Simulator:
 
         return criterion_for(self.cell.spec.criterion)
 
-    def with_start(self, start: tuple[float, float, float]) -> Simulator:
-        """The same cell with another start pose (x, y, heading_deg); shares this simulator's set-up."""
-        return Simulator(self.layout, start=start)
+    def with_start(self, start: tuple[float, float, float], phase: float | None = None) -> Simulator:
+        """The same cell with another start pose (x, y, heading_deg) and, if ``phase`` is given, the robot's
+        cycle at ``phase`` s when the episode starts; shares this simulator's set-up."""
+        if phase is None:
+            return Simulator(self.layout, start=start)
+        from cellstress.sim.build import with_phase
+
+        return Simulator(with_phase(self.layout, phase), start=start)
+
+    @property
+    def phase(self) -> float:
+        """The robot's path time at t = 0 (the cell's ``robot.task.phase`` or a start point's own)."""
+        return float(self.params.scal[K.C_PHASE0])
 
     # ---- facts ------------------------------------------------------------------------------------------
     @property
