@@ -76,6 +76,11 @@ def _short_waypoints(cell: dict) -> None:
     cell["robot"]["task"]["waypoints_deg"] = [w[:-1] for w in cell["robot"]["task"]["waypoints_deg"]]
 
 
+def _named_start(cell: dict, **extra) -> dict:
+    """A ``human.starts`` entry at the cell's start pose."""
+    return {"name": "door", **copy.deepcopy(cell["human"]["start"]), **extra}
+
+
 def _scanner(cell: dict) -> dict:
     return cell["devices"][_index(cell, "laser-scanner")]
 
@@ -217,6 +222,24 @@ CASES = [
         lambda c: c["robot"].update(capsules="manual"),
         "robot.capsules",
         ("'auto' or a list of capsules",),
+    ),
+    Case(
+        "start-phase-negative",
+        lambda c: c["human"].update(starts=[_named_start(c, phase=-1.5)]),
+        "human.starts[0].phase",
+        ("greater than or equal to 0", "-1.5"),
+    ),
+    Case(
+        "start-phase-not-a-number",
+        lambda c: c["human"].update(starts=[_named_start(c, phase="late")]),
+        "human.starts[0].phase",
+        ("valid number", "'late'"),
+    ),
+    Case(
+        "start-phase-infinite",
+        lambda c: c["human"].update(starts=[_named_start(c, phase=float("inf"))]),
+        "human.starts[0].phase",
+        ("finite",),
     ),
     Case(
         "capsule-on-unknown-link",

@@ -97,7 +97,11 @@ def risk(record: dict) -> float:
 
 def replay(sim: Simulator, actions, *, episode: int | None = None, kind: str = "hazard",
            recorded: list[dict] | None = None) -> EpisodeView:
-    """Play ``actions`` from the simulator's start and keep what a report needs."""
+    """Play ``actions`` from the simulator's start and keep what a report needs. A leading ``start:NAME``
+    (a cell with several start points) is played from that start, with its robot phase."""
+    from cellstress.search.multistart import split_start
+
+    sim, actions = split_start(sim, actions)
     trace = sim.run(list(actions))
     records = trace.records()
     matches = None
