@@ -32,8 +32,9 @@ def classes_of(sim, res):
     from cellstress.search.multistart import split_start
 
     if res.distinct is not None:
-        return [(d["episode"], d["actions"][0], (d["class"]["device"], d["class"]["robot_link"], d["class"]["body_region"],
-                                *d["class"]["approach_cell"][:2])) for d in res.distinct]
+        return [(d["episode"], d["actions"][0], (d["class"]["device"], d["class"]["robot_link"],
+                                                 d["class"]["body_region"], *d["class"]["approach_cell"][:2]))
+                for d in res.distinct]
     out, seen = [], set()
     for h in res.hazards:
         run_sim, rest = split_start(sim, h["actions"])

@@ -289,7 +289,8 @@ def search(
     cell: Annotated[str, typer.Argument(help=CELL_HELP)],
     out: Annotated[str, typer.Option("--out", "-o", help="Folder for result.json (created if needed).")],
     searcher: Annotated[str, typer.Option("--searcher", "-s", help="random, mcts (MCTS1: from s0 for the "
-                                          "whole budget) or mcts-commit (MCTS2: commit and re-root).")] = "mcts",
+                                          "whole budget), mcts-commit (MCTS2: commit and re-root) or evolve "
+                                          "(ours: mutates the best episodes).")] = "mcts",
     budget: Annotated[int, typer.Option("--budget", "-b", help="Episodes (one iteration = one episode of "
                                         "up to 8 actions from s0).")] = 200,
     seed: Annotated[int, typer.Option("--seed", help="Seed (>= 0) of numpy's SeedSequence.")] = 0,
@@ -312,7 +313,8 @@ def search(
                                                   "iso15066 (force limits per body region); default: the "
                                                   "cell file's.")] = None,
     distinct: Annotated[bool, typer.Option("--distinct", help="With --until budget: cluster the hazards "
-                                           "into classes, steer away from classes found, list each.")] = False,
+                                           "into classes, steer away from classes found, list each (evolve: "
+                                           "the budget shared between the start points in slices).")] = False,
 ) -> None:
     """Search a cell for a sequence of worker actions that ends in an unsafe contact; write result.json
     and its report (see 'cellstress report')."""
