@@ -53,7 +53,8 @@ class SimProblem:
         self.sim = sim
         self.n_actions = sim.n_actions
         self.actions_per_episode = sim.actions_per_episode
-        self._d, self._v = K.M_D, K.M_V
+        self._d, self._v, self._tstop = K.M_D, K.M_V, K.S_TSTOP
+        self._lookahead = {}
         self.reset = sim.reset
         self.step = sim.step
         self.is_unsafe = sim.is_unsafe
@@ -66,6 +67,16 @@ class SimProblem:
     def metrics(self, rows) -> tuple[float, float]:
         last = rows[-1]
         return float(last[self._d]), float(last[self._v])
+
+    def lookahead(self, state, rows, horizon=None, speed=1.6):
+        """The predictive gaps of ``rows`` (``sim.lookahead``), ``state`` being the state after them."""
+        key = (horizon, speed)
+        la = self._lookahead.get(key)
+        if la is None:
+            from cellstress.sim.lookahead import Lookahead
+
+            la = self._lookahead[key] = Lookahead(self.sim.params, horizon, speed)
+        return la.gaps(rows, state[self._tstop])
 
     def _iso_metrics(self, rows) -> tuple[float, float, float]:
         """(d_HR, v_R, predicted force / transient limit) at the action's last step (see ``IsoReward``)."""

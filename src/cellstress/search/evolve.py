@@ -48,7 +48,7 @@ import numpy as np
 from cellstress.search.common import Recorder, SearchError, SimProblem
 
 EVOLVE_KEY = 3
-SCORES = ("running", "risk", "both")
+SCORES = ("running", "risk", "both", "lookahead", "risk+lookahead", "running+lookahead", "all")
 REDRAWS = 50
 
 
@@ -65,6 +65,11 @@ class Evolve:
     sticky: float = 0.3
     score: str = "both"
     patience: int = 100
+    focus: float = 0.0
+    tries: int = 0
+    unique: bool = False
+    horizon: float = -1.0
+    speed: float = 1.6
 
     name = "evolve"
 
@@ -83,11 +88,19 @@ class Evolve:
     def run(self, problem, reward, rec: Recorder, seed: int) -> None:
         rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(EVOLVE_KEY,)))
         horizon, n_actions = problem.actions_per_episode, problem.n_actions
-        player = _Player(problem, reward)
+        player = _Player(problem, reward, None if self.horizon < 0 else self.horizon, self.speed, ahead=2 in {"running": (0,), "risk": (1,), "both": (0, 1)}.get(self.score, (2,)))
         played: set[tuple[int, ...]] = set()
         # per episode: (score, -episode, actions, step scores) for each step score in use
-        uses = {"running": (0,), "risk": (1,), "both": (0, 1)}[self.score]
+        uses = {"running": (0,), "risk": (1,), "both": (0, 1), "lookahead": (2,), "risk+lookahead": (1, 2),
+                "running+lookahead": (0, 2), "all": (0, 1, 2)}[self.score]
         archives: dict[int, list[tuple[float, int, list[int], list[float]]]] = {u: [] for u in uses}
+
+        children: dict[tuple[int, ...], int] = {}  # parent -> children made from it
+
+        def near_miss(entry) -> tuple[int, ...]:
+            """The actions up to the closest call (with ``unique``), else the whole parent."""
+            steps = entry[3]
+            return tuple(entry[2][: int(np.argmax(steps)) + 1]) if self.unique and steps else tuple(entry[2])
 
         def draw(prev: int, avoid: int) -> int:
             if prev >= 0 and prev != avoid and rng.random() < self.sticky:
@@ -125,11 +138,24 @@ class Evolve:
                 best, since = best_scores(), 0
             archive = archives[uses[int(rng.integers(len(uses)))] if len(uses) > 1 else uses[0]]
             archive.sort(reverse=True)
-            top = archive[: self.pool]
+            top, seen_keys = [], set()
+            for e in archive:
+                key = near_miss(e)
+                if (self.unique and key in seen_keys) or (self.tries and children.get(key, 0) >= self.tries):
+                    continue
+                seen_keys.add(key)
+                top.append(e)
+                if len(top) == self.pool:
+                    break
+            if not top:
+                top = archive[: self.pool]
             for _ in range(REDRAWS):
                 _, _, parent, steps = top[int(rng.integers(len(top)))]
                 k_best = int(np.argmax(steps)) if steps else 0
-                j = int(rng.integers(min(k_best + 1, horizon - 1) + 1))
+                if rng.random() < self.focus:
+                    j = min(k_best + int(rng.integers(2)), horizon - 1)
+                else:
+                    j = int(rng.integers(min(k_best + 1, horizon - 1) + 1))
                 child = parent[:j]
                 child.append(draw(child[-1] if child else -1, parent[j] if j < len(parent) else -1))
                 if rng.random() < self.keep_tail and len(parent) == horizon:
@@ -138,6 +164,8 @@ class Evolve:
                     tail(child)
                 if tuple(child) not in played:
                     break
+            key = near_miss((None, None, parent, steps))
+            children[key] = children.get(key, 0) + 1
             play(child)
             now = best_scores()
             if any(n > b for n, b in zip(now, best, strict=True)):
@@ -149,8 +177,10 @@ class Evolve:
 class _Player:
     """Plays action sequences from s0, caching every prefix's state, return, max risk and step scores."""
 
-    def __init__(self, problem, reward):
+    def __init__(self, problem, reward, horizon=None, speed=1.6, ahead=False):
         self.problem, self.reward = problem, reward
+        self.horizon, self.speed = horizon, speed
+        self.ahead = ahead and hasattr(problem, "lookahead")
         self.cache: dict[tuple[int, ...], tuple] = {(): (problem.reset(), 0.0, 0.0, ())}
         self.rows = isinstance(problem, SimProblem) and hasattr(reward, "criterion")
         if self.rows:
@@ -159,15 +189,18 @@ class _Player:
             self.cols = (K.M_D, K.M_V, K.M_PHASE, K.PHASE_RUNNING)
             self.index = reward.criterion.safety_index
 
-    def step_score(self, rows, risk: float) -> tuple[float, float]:
-        """(running, risk) step scores of one action."""
+    def step_score(self, rows, risk: float, state) -> tuple[float, float, float]:
+        """(running, risk, lookahead) step scores of one action."""
+        ahead = risk
+        if self.ahead:
+            ahead = -float(np.min(self.problem.lookahead(state, rows, self.horizon, self.speed)))
         if not self.rows:
-            return risk, risk
+            return risk, risk, ahead
         cd, cv, cp, running = self.cols
         d, v = rows[:, cd], rows[:, cv]
         m = rows[:, cp] == running
         run = float(np.max(1.0 / (d[m] ** 2 + 1.0))) if m.any() else 0.0
-        return run, max(1.0 / self.index(float(dk), float(vk)) for dk, vk in zip(d, v, strict=True))
+        return run, max(1.0 / self.index(float(dk), float(vk)) for dk, vk in zip(d, v, strict=True)), ahead
 
     def play(self, actions: list[int]):
         p, horizon = self.problem, self.problem.actions_per_episode
@@ -185,7 +218,7 @@ class _Player:
             r, rk = self.reward(*p.metrics(rows), k == horizon - 1, unsafe)
             ret += r
             risk = max(risk, rk)
-            steps.append(self.step_score(rows, rk))
+            steps.append(self.step_score(rows, rk, state))
             out.append(a)
             k += 1
             self.cache[tuple(out)] = (state, ret, risk, tuple(steps))
