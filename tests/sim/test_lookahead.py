@@ -92,6 +92,17 @@ def test_lookahead_leaves_the_simulator_alone() -> None:
     assert (g <= rows1[:, K.M_D] + 1e-12).all()
 
 
+def test_problem_and_simulator_expose_it() -> None:
+    from cellstress.search.common import SimProblem
+
+    sim = Simulator("s2-elbow-intrusion")
+    state, rows = sim.step(sim.reset(), action_index("walk+upright"))
+    direct = Lookahead(sim.params, 0.3, 1.0).gaps(rows, state[K.S_TSTOP])
+    np.testing.assert_array_equal(sim.lookahead(0.3, 1.0).gaps(rows, state[K.S_TSTOP]), direct)
+    np.testing.assert_array_equal(SimProblem(sim).lookahead(state, rows, 0.3, 1.0), direct)
+    assert sim.lookahead().horizon == pytest.approx(0.05 + 0.15)  # the curtain's response + stopping time
+
+
 def test_bad_window() -> None:
     sim = Simulator("s1-scanner-width")
     with pytest.raises(ValueError):

@@ -68,14 +68,13 @@ class SimProblem:
         last = rows[-1]
         return float(last[self._d]), float(last[self._v])
 
-    def lookahead(self, state, rows, horizon=None, speed=1.6):
-        """The predictive gaps of ``rows`` (``sim.lookahead``), ``state`` being the state after them."""
+    def lookahead(self, state, rows, horizon=None, speed=1.6) -> np.ndarray:
+        """The predictive gap of each of ``rows`` (``sim.lookahead``; ``state`` is the state after them): an
+        optional score a searcher may ask for. It plays nothing: the budget is unaffected."""
         key = (horizon, speed)
         la = self._lookahead.get(key)
         if la is None:
-            from cellstress.sim.lookahead import Lookahead
-
-            la = self._lookahead[key] = Lookahead(self.sim.params, horizon, speed)
+            la = self._lookahead[key] = self.sim.lookahead(horizon, speed)
         return la.gaps(rows, state[self._tstop])
 
     def _iso_metrics(self, rows) -> tuple[float, float, float]:

@@ -16,10 +16,15 @@ count: contact with a still robot is not a hazard (contact-while-moving; under i
 tolerance, every pose with v_R > 0 counts). A step with no moving pose in its
 window has gap +inf.
 
+The default window is ISO 13855's T for the fastest device, its response time plus the robot's stopping time
+(0.05 + 0.15 = 0.2 s in the reference cells): the shortest time for which the robot moves on after the worker
+is first seen, whichever device sees them. The default K is ISO 13855's 1.6 m/s.
+
 It is a *score* for searchers, not part of the simulation: the episode, its metric rows and its outcome are
 unchanged, and no episode is played. The extra work is (horizon / dt + 1) robot poses and separations per time
-step (11 for a 0.5 s horizon at 50 ms), done by the same compiled functions as the simulator's
-(``kernels.robot_live``, ``kernels.pose_body``, ``kernels.separation``) on a Work of its own.
+step (5 for the default 0.2 s at 50 ms), done by the same compiled functions as the simulator's
+(``kernels.robot_live``, ``kernels.human_pose``, ``kernels.near_fences``, ``kernels.separation``) on a Work of
+its own; ``kernels.py`` is not changed.
 
 Why it helps: a closeness score measured at the same instant cannot tell a worker who stands at a light
 curtain while the robot dwells from one who stands there just before the arm moves on (docs/results.md, S2).
