@@ -66,8 +66,46 @@ def test_no_episode_is_played_twice_before_a_hazard() -> None:
     assert len(out.top) == 200  # TopK keeps one entry per distinct action sequence
 
 
+def test_score_names() -> None:
+    assert Evolve().uses == (0, 1)  # "both": running + risk
+    assert Evolve(score="all").uses == (0, 1, 2)
+    assert Evolve(score="lookahead+risk").uses == (1, 2)
+    assert Evolve(score="running").uses == (0,)
+
+
+def test_lookahead_falls_back_to_the_risk_on_the_toy() -> None:
+    # the toy has no lookahead: the score "lookahead" is then the risk, and the search is the same
+    a = run_search(ToyWalk(), REWARD, "evolve", 300, 2, until="budget", score="lookahead")
+    b = run_search(ToyWalk(), REWARD, "evolve", 300, 2, until="budget", score="risk")
+    assert a == b and len(a.hazards) > 1
+
+
+def test_focus_still_beats_random() -> None:
+    evo = [episodes_to_hazard("evolve", s, 3000, focus=0.5) for s in SEEDS]
+    assert statistics.median(evo) < 500
+
+
+def test_lookahead_search_on_a_cell_is_a_pure_function_of_its_seed() -> None:
+    from cellstress.search.common import SimProblem
+    from cellstress.sim.simulator import Simulator
+
+    sim = Simulator("s2-elbow-intrusion")
+    reward = Reward(sim.criterion)
+    runs = [run_search(SimProblem(sim), reward, "evolve", 40, seed, until="budget", score="all")
+            for seed in (1, 1, 2)]
+    plain = run_search(SimProblem(sim), reward, "evolve", 40, 1, until="budget")
+    assert runs[0] == runs[1]
+    assert runs[0].risks != runs[2].risks
+    assert runs[0].episodes == 40 and len(runs[0].top) == 10
+    # the third ranking changes which parents are mutated (the first n_init = 6 random episodes are shared)
+    assert runs[0].risks[:6] == plain.risks[:6] and runs[0].risks != plain.risks
+
+
 @pytest.mark.parametrize("options", [{"n_init": 0}, {"pool": 1.5}, {"keep_tail": 1.5}, {"sticky": -0.1},
-                                     {"score": "distance"}, {"patience": -1}, {"n_init": True}])
+                                     {"score": "distance"}, {"patience": -1}, {"n_init": True},
+                                     {"score": "risk+risk"}, {"score": "risk+"}, {"score": 3}, {"focus": 1.5},
+                                     {"horizon": -0.1}, {"speed": -1.0}, {"speed": float("inf")},
+                                     {"horizon": True}])
 def test_bad_options(options) -> None:
     with pytest.raises(SearchError):
         Evolve(**options)

@@ -53,7 +53,8 @@ class SimProblem:
         self.sim = sim
         self.n_actions = sim.n_actions
         self.actions_per_episode = sim.actions_per_episode
-        self._d, self._v = K.M_D, K.M_V
+        self._d, self._v, self._tstop = K.M_D, K.M_V, K.S_TSTOP
+        self._lookahead = {}
         self.reset = sim.reset
         self.step = sim.step
         self.is_unsafe = sim.is_unsafe
@@ -66,6 +67,15 @@ class SimProblem:
     def metrics(self, rows) -> tuple[float, float]:
         last = rows[-1]
         return float(last[self._d]), float(last[self._v])
+
+    def lookahead(self, state, rows, horizon=None, speed=1.6) -> np.ndarray:
+        """The predictive gap of each of ``rows`` (``sim.lookahead``; ``state`` is the state after them): an
+        optional score a searcher may ask for. It plays nothing: the budget is unaffected."""
+        key = (horizon, speed)
+        la = self._lookahead.get(key)
+        if la is None:
+            la = self._lookahead[key] = self.sim.lookahead(horizon, speed)
+        return la.gaps(rows, state[self._tstop])
 
     def _iso_metrics(self, rows) -> tuple[float, float, float]:
         """(d_HR, v_R, predicted force / transient limit) at the action's last step (see ``IsoReward``)."""

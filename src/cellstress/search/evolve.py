@@ -17,11 +17,19 @@ as in the MCTS tree, which saves computation but never an episode), so the budge
      quantity ISO 13855's separation distance is about, and ignores contacts with a stopping or stopped
      robot. It needs the simulator's stop phase; on other problems (the toy tests) it equals ``risk``.
    * ``risk``: the criterion's 1/c_S (the paper's e^{v_R} / (d_HR² + 1)), at every time step.
+   * ``lookahead``: minus the predictive gap of ``sim.lookahead`` (the problem's ``lookahead``): how close the
+     robot, moving on along its programmed path for ``horizon`` seconds (None: the fastest device's response
+     time plus the stopping time, ISO 13855's T), comes to the worker's pose of the time step, less what a
+     worker approaching at ``speed`` (ISO 13855's K) covers meanwhile. It costs horizon / 50 ms + 1 robot
+     poses and separations per time step, and no episode. On a problem without ``lookahead`` (the toy tests)
+     it equals ``risk``.
 
-   ``score`` = "both" (default) keeps one ranking per step score and draws each parent from one of the two at
-   random; "running" or "risk" uses one.
+   ``score`` names the step scores in use, joined by "+" (e.g. "risk+lookahead"); "both" (the default) is
+   "running+risk" and "all" is "running+risk+lookahead". Each has its own ranking, and each parent is drawn
+   from one of them at random.
 3. **Mutate**: draw a parent uniformly from the ``pool`` best episodes of the ranking; pick a position j
-   uniformly in 0..min(k* + 1, horizon - 1) (changing a later action cannot improve the closest call); keep
+   uniformly in 0..min(k* + 1, horizon - 1) (changing a later action cannot improve the closest call), or,
+   with probability ``focus``, uniformly from k* and k* + 1 (the closest call and the action after it); keep
    the parent's actions before j, play a different action at j (sticky-random, never the parent's), then,
    with probability ``keep_tail``, the parent's remaining actions, else a fresh sticky-random tail. A child
    already played is redrawn (up to 50 times: the simulator is deterministic, a repeat would teach nothing).
@@ -31,9 +39,11 @@ as in the MCTS tree, which saves computation but never an episode), so the budge
    of 15 seeds without it; with the campaign's budget of 200 it changes no run on seeds 0-39).
 
 Defaults (``n_init`` = 6, ``pool`` = 3, ``keep_tail`` = 0.5, ``sticky`` = 0.3, ``score`` = "both",
-``patience`` = 100) were chosen on the three flawed reference cells, 40 seeds, budget 200; docs/results.md gives
-the numbers and the alternatives that did not help. Nothing in it knows a cell or where its hazard is: it sees
-only the ``Problem`` interface, the reward, and (in a cell) the per-step metric rows d_HR, v_R and stop phase.
+``patience`` = 100, ``focus`` = 0) were chosen on the three flawed reference cells, 40 seeds, budget 200;
+docs/results.md gives the numbers and the alternatives that did not help (the lookahead score among them: it
+changes the mean episodes by less than the seed-to-seed noise). Nothing in it knows a cell or where its hazard
+is: it sees only the ``Problem`` interface, the reward, and (in a cell) the per-step metric rows d_HR, v_R and
+stop phase, and the problem's optional ``lookahead``.
 
 Randomness: one numpy Generator from ``SeedSequence(seed, spawn_key=(3,))``.
 """
@@ -48,7 +58,8 @@ import numpy as np
 from cellstress.search.common import Recorder, SearchError, SimProblem
 
 EVOLVE_KEY = 3
-SCORES = ("running", "risk", "both")
+SCORES = ("running", "risk", "lookahead")  # step scores, in the order of _Player.step_score
+ALIASES = {"both": "running+risk", "all": "running+risk+lookahead"}
 REDRAWS = 50
 
 
@@ -56,8 +67,10 @@ REDRAWS = 50
 class Evolve:
     """Options of ``evolve``: ``n_init`` random episodes first, parents from the ``pool`` best, mutated
     tails kept with probability ``keep_tail``, random actions repeated with probability ``sticky``, the
-    step ``score`` ("both", "running" or "risk"), restart after ``patience`` episodes without progress
-    (0: never). See the module docstring."""
+    step scores ``score`` ("running", "risk", "lookahead" joined by "+"; "both", "all"), restart after
+    ``patience`` episodes without progress (0: never), mutation at the closest call or the action after it
+    with probability ``focus``, and the lookahead's window ``horizon`` [s] (None: the cell's ISO 13855 T)
+    and approach ``speed`` [m/s]. See the module docstring."""
 
     n_init: int = 6
     pool: int = 3
@@ -65,6 +78,9 @@ class Evolve:
     sticky: float = 0.3
     score: str = "both"
     patience: int = 100
+    focus: float = 0.0
+    horizon: float | None = None
+    speed: float = 1.6
 
     name = "evolve"
 
@@ -73,20 +89,33 @@ class Evolve:
             v = getattr(self, k)
             if isinstance(v, bool) or not isinstance(v, int) or v < lo:
                 raise SearchError(f"{k} must be a whole number >= {lo}, not {v!r}")
-        for k in ("keep_tail", "sticky"):
+        for k in ("keep_tail", "sticky", "focus"):
             v = getattr(self, k)
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= v <= 1.0:
                 raise SearchError(f"{k} must be a number in 0..1, not {v!r}")
-        if self.score not in SCORES:
-            raise SearchError(f"score must be one of {', '.join(SCORES)}, not {self.score!r}")
+        parts = ALIASES.get(self.score, self.score).split("+") if isinstance(self.score, str) else [None]
+        if not set(parts) <= set(SCORES) or len(set(parts)) != len(parts):
+            raise SearchError(f"score must be {', '.join(SCORES)} or several of them joined by '+' "
+                              f"({', '.join(ALIASES)} are short for {', '.join(ALIASES.values())}), not {self.score!r}")
+        for k, v in (("horizon", self.horizon), ("speed", self.speed)):
+            if v is None and k == "horizon":
+                continue
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= v < math.inf:
+                raise SearchError(f"{k} must be a number >= 0, not {v!r}")
+
+    @property
+    def uses(self) -> tuple[int, ...]:
+        """Indices (into SCORES) of the step scores in use."""
+        return tuple(sorted(SCORES.index(p) for p in ALIASES.get(self.score, self.score).split("+")))
 
     def run(self, problem, reward, rec: Recorder, seed: int) -> None:
         rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(EVOLVE_KEY,)))
         horizon, n_actions = problem.actions_per_episode, problem.n_actions
-        player = _Player(problem, reward)
+        uses = self.uses
+        ahead = (self.horizon, self.speed) if SCORES.index("lookahead") in uses else None
+        player = _Player(problem, reward, ahead)
         played: set[tuple[int, ...]] = set()
         # per episode: (score, -episode, actions, step scores) for each step score in use
-        uses = {"running": (0,), "risk": (1,), "both": (0, 1)}[self.score]
         archives: dict[int, list[tuple[float, int, list[int], list[float]]]] = {u: [] for u in uses}
 
         def draw(prev: int, avoid: int) -> int:
@@ -134,7 +163,10 @@ class Evolve:
             for _ in range(REDRAWS):
                 _, _, parent, steps = top[int(rng.integers(len(top)))]
                 k_best = int(np.argmax(steps)) if steps else 0
-                j = int(rng.integers(min(k_best + 1, horizon - 1) + 1))
+                if self.focus and rng.random() < self.focus:  # (no draw at 0: the defaults' stream is kept)
+                    j = min(k_best + int(rng.integers(2)), horizon - 1)
+                else:
+                    j = int(rng.integers(min(k_best + 1, horizon - 1) + 1))
                 child = parent[:j]
                 child.append(draw(child[-1] if child else -1, parent[j] if j < len(parent) else -1))
                 if rng.random() < self.keep_tail and len(parent) == horizon:
@@ -152,10 +184,12 @@ class Evolve:
 
 
 class _Player:
-    """Plays action sequences from s0, caching every prefix's state, return, max risk and step scores."""
+    """Plays action sequences from s0, caching every prefix's state, return, max risk and step scores.
+    ``ahead``: (horizon, speed) of the lookahead score, or None when it is not in use (it is not computed)."""
 
-    def __init__(self, problem, reward):
+    def __init__(self, problem, reward, ahead=None):
         self.problem, self.reward = problem, reward
+        self.ahead = ahead if hasattr(problem, "lookahead") else None
         self.cache: dict[tuple[int, ...], tuple] = {(): (problem.reset(), 0.0, 0.0, ())}
         self.rows = isinstance(problem, SimProblem) and hasattr(reward, "criterion")
         if self.rows:
@@ -164,15 +198,17 @@ class _Player:
             self.cols = (K.M_D, K.M_V, K.M_PHASE, K.PHASE_RUNNING)
             self.index = reward.criterion.safety_index
 
-    def step_score(self, rows, risk: float) -> tuple[float, float]:
-        """(running, risk) step scores of one action."""
+    def step_score(self, rows, risk: float, state) -> tuple[float, float, float]:
+        """(running, risk, lookahead) step scores of one action (``SCORES``' order)."""
+        # the best (smallest) predictive gap of the action's time steps; -inf if the robot never moves in reach
+        ahead = risk if self.ahead is None else -float(np.min(self.problem.lookahead(state, rows, *self.ahead)))
         if not self.rows:
-            return risk, risk
+            return risk, risk, ahead
         cd, cv, cp, running = self.cols
         d, v = rows[:, cd], rows[:, cv]
         m = rows[:, cp] == running
         run = float(np.max(1.0 / (d[m] ** 2 + 1.0))) if m.any() else 0.0
-        return run, max(1.0 / self.index(float(dk), float(vk)) for dk, vk in zip(d, v, strict=True))
+        return run, max(1.0 / self.index(float(dk), float(vk)) for dk, vk in zip(d, v, strict=True)), ahead
 
     def play(self, actions: list[int]):
         p, horizon = self.problem, self.problem.actions_per_episode
@@ -190,7 +226,7 @@ class _Player:
             r, rk = self.reward(*p.metrics(rows), k == horizon - 1, unsafe)
             ret += r
             risk = max(risk, rk)
-            steps.append(self.step_score(rows, rk))
+            steps.append(self.step_score(rows, rk, state))
             out.append(a)
             k += 1
             self.cache[tuple(out)] = (state, ret, risk, tuple(steps))

@@ -195,6 +195,13 @@ class Simulator:
     def restore(snapshot: bytes) -> np.ndarray:
         return np.frombuffer(snapshot, dtype=np.float64).copy()
 
+    def lookahead(self, horizon: float | None = None, speed: float = 1.6):
+        """The predictive-gap score of this cell (``sim.lookahead.Lookahead``): how close the robot, moving on
+        along its path for ``horizon`` seconds, comes to a worker's pose, less ``speed`` times the delay."""
+        from cellstress.sim.lookahead import Lookahead
+
+        return Lookahead(self.params, horizon, speed)
+
     # ---- episodes ---------------------------------------------------------------------------------------
     def run(self, actions) -> Trace:
         """Play a whole action sequence from s0 (stopping at the first unsafe step). A leading ``start:NAME``

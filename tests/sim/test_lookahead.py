@@ -1,0 +1,109 @@
+"""The predictive gap (sim/lookahead.py) against a brute force: the simulator's own sense-and-measure on a
+state that keeps the worker's pose and moves the clock on, and the gap of a zero-length window."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cellstress.human.actions import action_index
+from cellstress.sim import kernels as K
+from cellstress.sim.lookahead import Lookahead, default_horizon
+from cellstress.sim.simulator import Simulator
+
+# an S2 hazard (curtain crossed, elbow touched while braking) and an S1 walk into the scanner field
+EPISODES = {
+    "s2-elbow-intrusion": ["walk+upright", "walk+upright", "turn-right-45+bend-right", "walk+bend-left"],
+    "s1-scanner-width": ["walk+upright", "walk+bend-forward", "walk+upright", "turn-left-45+upright",
+                         "walk+bend-forward", "walk+upright"],
+}
+
+
+def brute_gaps(sim, rows, t_stop, horizon, speed):
+    """For each row: the worker's pose at step k, the clock at k + j (j = 0 .. horizon / dt), measured by
+    kernels.sense_and_measure (the simulator's step, minus the walking); min of d_HR - speed * j * dt."""
+    P, dt = sim.params, sim.dt
+    W = K.make_work(P)
+    vtol = P.scal[K.C_VTOL]
+    out = []
+    for r in rows:
+        best = np.inf
+        for j in range(int(round(horizon / dt)) + 1):
+            s = np.zeros(K.NS)
+            s[K.S_K] = r[K.M_STEP] + j
+            s[K.S_X], s[K.S_Y], s[K.S_HEADING], s[K.S_FWD], s[K.S_LAT] = (
+                r[K.M_X], r[K.M_Y], r[K.M_HEADING], r[K.M_FWD], r[K.M_LAT])
+            s[K.S_TSTOP] = np.inf if r[K.M_PHASE] == K.PHASE_RUNNING else t_stop
+            s[K.S_TRIG_DEV] = s[K.S_TRIG_T] = -1.0
+            row = np.zeros(K.NM)
+            K.sense_and_measure(P, s, W, row, -1)
+            if row[K.M_V] > vtol:
+                best = min(best, row[K.M_D] - speed * j * dt)
+        out.append(best)
+    return np.array(out)
+
+
+@pytest.mark.parametrize("cell", sorted(EPISODES))
+def test_gaps_match_brute_force(cell) -> None:
+    sim = Simulator(cell)
+    la = Lookahead(sim.params)
+    assert la.horizon == pytest.approx(default_horizon(sim.params))
+    state, phases = sim.reset(), set()
+    for a in EPISODES[cell]:
+        state, rows = sim.step(state, action_index(a))
+        got = la.gaps(rows, state[K.S_TSTOP])
+        want = brute_gaps(sim, rows, state[K.S_TSTOP], la.horizon, la.speed)
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
+        phases |= set(rows[:, K.M_PHASE].astype(int).tolist())
+        if sim.is_unsafe(state):
+            break
+    # the episodes cover the running robot and a requested stop
+    assert K.PHASE_RUNNING in phases and phases - {K.PHASE_RUNNING}
+    if cell == "s2-elbow-intrusion":
+        assert sim.is_unsafe(state)
+
+
+def test_zero_window_is_d_hr_of_the_moving_robot() -> None:
+    sim = Simulator("s2-elbow-intrusion")
+    la = Lookahead(sim.params, horizon=0.0, speed=1.6)
+    state = sim.reset()
+    rows_all, gaps = [], []
+    for a in ["walk+upright"] * 2 + ["turn-left-45+upright", "turn-right-45+upright"] * 3:
+        state, rows = sim.step(state, action_index(a))
+        rows_all.append(rows)
+        gaps.append(la.gaps(rows, state[K.S_TSTOP]))
+    rows, gaps = np.concatenate(rows_all), np.concatenate(gaps)
+    moving = rows[:, K.M_V] > sim.params.scal[K.C_VTOL]
+    assert moving.any() and not moving.all()  # the S2 robot dwells in its fold for 0.2 s (t = 0.37-0.57 s)
+    np.testing.assert_allclose(gaps[moving], rows[moving, K.M_D], rtol=0, atol=1e-12)
+    assert np.isinf(gaps[~moving]).all()
+
+
+def test_lookahead_leaves_the_simulator_alone() -> None:
+    sim = Simulator("s1-scanner-width")
+    la = Lookahead(sim.params, horizon=0.3, speed=0.0)
+    s0 = sim.reset()
+    s1, rows1 = sim.step(s0, 0)
+    la.gaps(rows1, s1[K.S_TSTOP])
+    s2, rows2 = sim.step(s0, 0)
+    assert np.array_equal(s1, s2) and np.array_equal(rows1, rows2)
+    # the gap never exceeds d_HR now (tau = 0 is in the window) while the robot moves
+    g = la.gaps(rows1, s1[K.S_TSTOP])
+    assert (g <= rows1[:, K.M_D] + 1e-12).all()
+
+
+def test_problem_and_simulator_expose_it() -> None:
+    from cellstress.search.common import SimProblem
+
+    sim = Simulator("s2-elbow-intrusion")
+    state, rows = sim.step(sim.reset(), action_index("walk+upright"))
+    direct = Lookahead(sim.params, 0.3, 1.0).gaps(rows, state[K.S_TSTOP])
+    np.testing.assert_array_equal(sim.lookahead(0.3, 1.0).gaps(rows, state[K.S_TSTOP]), direct)
+    np.testing.assert_array_equal(SimProblem(sim).lookahead(state, rows, 0.3, 1.0), direct)
+    assert sim.lookahead().horizon == pytest.approx(0.05 + 0.15)  # the curtain's response + stopping time
+
+
+def test_bad_window() -> None:
+    sim = Simulator("s1-scanner-width")
+    with pytest.raises(ValueError):
+        Lookahead(sim.params, horizon=-0.1)
