@@ -11,7 +11,9 @@ tau(t) = t_s + d - d^2 / (2 T) for d = t - t_s < T. Nothing is integrated, so no
 Speed: numba reference-counts arrays, and passing a tuple of arrays (SimParams, Work) into an inlined function
 increments and decrements every member, atomically. On the hot path that bookkeeping once took two thirds of
 the run time. So the inlined helpers take the arrays they read (and scalars, and index rows element-wise
-rather than slicing views); only the entry points take SimParams and Work.
+rather than slicing views); only the entry points take SimParams and Work. The step itself (step_action,
+sense_and_measure and the non-inlined helpers they call) allocates nothing and is compiled without
+reference counting at all (``geometry.NO_REFCOUNT``); only run_batch, which allocates, keeps it.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from numba import njit, prange
 from numba.typed import List
 
 from cellstress.sim.geometry import (
+    NO_REFCOUNT,
     point_segment_2d,
     polygon_distance,
     segment_rectangle_xyz,
@@ -172,24 +175,23 @@ def _joint_trajectory(scal, seg_start, seg_move, wp, tau, sigma, q, qd):
 @njit(cache=True, error_model="numpy", inline="always")
 def _forward_kinematics(parents, placements, base, axes, q, rot, pos):
     """World rotation and origin of every joint frame."""
+    # (No temporary array and no row views: each would be allocated or reference-counted on every call.)
     nj = q.shape[0]
-    m = np.empty((3, 3))
     for j in range(nj):
         par = parents[j]
-        pl = placements[j]
-        # parent frame in the world
+        # parent frame in the world; its rotation part goes to rot[j] for now
         for r in range(3):
             for c in range(3):
                 acc = 0.0
                 for k in range(3):
                     pr = base[r, k] if par < 0 else rot[par, r, k]
-                    acc += pr * pl[k, c]
-                m[r, c] = acc
+                    acc += pr * placements[j, k, c]
+                rot[j, r, c] = acc
         for r in range(3):
             acc = base[r, 3] if par < 0 else pos[par, r]
             for k in range(3):
                 pr = base[r, k] if par < 0 else rot[par, r, k]
-                acc += pr * pl[k, 3]
+                acc += pr * placements[j, k, 3]
             pos[j, r] = acc
         # rotation about the joint axis (Rodrigues)
         kx, ky, kz = axes[j, 0], axes[j, 1], axes[j, 2]
@@ -199,7 +201,7 @@ def _forward_kinematics(parents, placements, base, axes, q, rot, pos):
         r10, r11, r12 = ky * kx * v + kz * s, c + ky * ky * v, ky * kz * v - kx * s
         r20, r21, r22 = kz * kx * v - ky * s, kz * ky * v + kx * s, c + kz * kz * v
         for r in range(3):
-            a0, a1, a2 = m[r, 0], m[r, 1], m[r, 2]
+            a0, a1, a2 = rot[j, r, 0], rot[j, r, 1], rot[j, r, 2]
             rot[j, r, 0] = a0 * r00 + a1 * r10 + a2 * r20
             rot[j, r, 1] = a0 * r01 + a1 * r11 + a2 * r21
             rot[j, r, 2] = a0 * r02 + a1 * r12 + a2 * r22
@@ -403,7 +405,7 @@ def reach_lookup(vals, origin, h, px, py, pz):
     return c0 * (1 - fz) + c1 * fz + np.sqrt(ex + ey + ez)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _edge_detour(sx, sy, sz, qx, qy, qz, ex, ey, ez, dx, dy, dz, length):
     """Shortest path s -> e -> q with e on the edge (ex, ey, ez) + t d, t in [0, length]; returns (len, t)."""
     ts = (sx - ex) * dx + (sy - ey) * dy + (sz - ez) * dz
@@ -418,7 +420,7 @@ def _edge_detour(sx, sy, sz, qx, qy, qz, ex, ey, ez, dx, dy, dz, length):
     return d1 + d2, t
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def _path_clear(fences, near, n_near, ax, ay, az, bx, by, bz):
     """No near fence panel lies across the straight segment a-b."""
     for m in range(n_near):
@@ -437,13 +439,16 @@ def _path_clear(fences, near, n_near, ax, ay, az, bx, by, bz):
     return True
 
 
-@njit(cache=True, error_model="numpy")
-def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz):
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff=np.inf):
     """Length of the shortest arm path from shoulder s to q around the near fence panels, over their top
-    edge or around their ends (inf if every such path is blocked); |s - q| when nothing is in the way."""
+    edge or around their ends (inf if every such path is blocked); |s - q| when nothing is in the way.
+
+    A finite ``cutoff`` says that any length from it up will do: the result is exact below it and ``cutoff``
+    otherwise, and bends that are not shorter are not checked for crossings (most of the cost)."""
     if _path_clear(fences, near, n_near, sx, sy, sz, qx, qy, qz):
         return np.sqrt((sx - qx) ** 2 + (sy - qy) ** 2 + (sz - qz) ** 2)
-    best = np.inf
+    best = cutoff
     nudge = 0.01  # step the bend point off the panel so the crossing tests are not degenerate
     for m in range(n_near):
         i = near[m]
@@ -470,20 +475,31 @@ def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _reach_value(reach, origin, h, arm_len, fences, near, sh, tr, side, n_near, px, py, pz):
-    """Signed distance from p to the reach volume of arm ``side`` (0 left, 1 right), fences respected."""
-    s0, s1, s2 = sh[side, 0], sh[side, 1], sh[side, 2]
-    dx, dy, dz = px - s0, py - s1, pz - s2
+def _reach_field(reach, origin, h, sh, tr, side, px, py, pz):
+    """Signed distance from p to the reach volume of arm ``side`` (0 left, 1 right), fences ignored."""
+    dx, dy, dz = px - sh[side, 0], py - sh[side, 1], pz - sh[side, 2]
     l0 = tr[0, 0] * dx + tr[1, 0] * dy + tr[2, 0] * dz
     ly = tr[0, 1] * dx + tr[1, 1] * dy + tr[2, 1] * dz
     l1 = -ly if side == 0 else ly
     l2 = tr[0, 2] * dx + tr[1, 2] * dy + tr[2, 2] * dz
-    f = reach_lookup(reach, origin, h, l0, l1, l2)
+    return reach_lookup(reach, origin, h, l0, l1, l2)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _fence_value(arm_len, fences, near, sh, side, n_near, f, px, py, pz, cutoff):
+    """The reach value ``f`` raised where the near fence panels make the hand go the long way round; exact
+    below ``cutoff``, and at least ``cutoff`` otherwise."""
+    g = fence_detour(fences, near, n_near, sh[side, 0], sh[side, 1], sh[side, 2], px, py, pz,
+                     cutoff + arm_len) - arm_len
+    return g if g > f else f
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _reach_value(reach, origin, h, arm_len, fences, near, sh, tr, side, n_near, px, py, pz):
+    """Signed distance from p to the reach volume of arm ``side`` (0 left, 1 right), fences respected."""
+    f = _reach_field(reach, origin, h, sh, tr, side, px, py, pz)
     if n_near > 0:
-        detour = fence_detour(fences, near, n_near, s0, s1, s2, px, py, pz)
-        g = detour - arm_len
-        if g > f:
-            f = g
+        f = _fence_value(arm_len, fences, near, sh, side, n_near, f, px, py, pz, np.inf)
     return f
 
 
@@ -521,24 +537,36 @@ def reach_to_segment(reach, origin, h, arm_len, fences, near, sh, tr, side, n_ne
     Stops early once the rest of the segment cannot come below ``bound``. The minimum is found to within
     the field's grid spacing plus TRACE_REL_TOL of the distance. Writes the closest axis point to out_q.
     """
-    step_cap = np.inf if n_near == 0 else 2.0 * h  # fence detours make the field jump: walk slowly there
     L = np.sqrt((bx - ax) ** 2 + (by - ay) ** 2 + (bz - az) ** 2)
     best = np.inf
     t = 0.0
     while True:
         tt = t / L if L > 0.0 else 0.0
         px, py, pz = ax + tt * (bx - ax), ay + tt * (by - ay), az + tt * (bz - az)
-        f = _reach_value(reach, origin, h, arm_len, fences, near, sh, tr, side, n_near, px, py, pz)
+        fl = _reach_field(reach, origin, h, sh, tr, side, px, py, pz)
+        f = fl
+        # The fenced value is never below fl, so where fl >= best it cannot be a new best, and where
+        # fl >= bound + r it cannot matter to the caller (which ignores results >= bound): skip the detour.
+        # Nor does its exact value from bound + r + h up: it is no new best then, and the stride below is 2 h.
+        if n_near > 0 and fl < best and fl < bound + r:
+            f = _fence_value(arm_len, fences, near, sh, side, n_near, fl, px, py, pz, bound + r + h)
         if f < best:
             best = f
             out_q[0], out_q[1], out_q[2] = px, py, pz
-        if t >= L or f - (L - t) - r >= bound:
-            break
-        # no point within `step` can undercut min(best, bound) by more than the tolerance
         target = best if best < bound + r else bound + r
-        step = f - target + h + TRACE_REL_TOL * (target if target > 0.0 else 0.0)
-        if step > step_cap:
-            step = step_cap
+        slack = TRACE_REL_TOL * (target if target > 0.0 else 0.0)
+        if fl >= target:
+            # The fenceless field is 1-Lipschitz and never above the fenced value, so it bounds the rest of
+            # the axis from below: no point within this step can undercut min(best, bound) by more than h + slack.
+            step = fl - target + h + slack
+        else:
+            # A panel holds the hand back here (fl < target <= f): the fenced value jumps where the hand's
+            # way round changes, so walk in strides of at most 2 h, as on its own it would need.
+            step = f - target + h + slack
+            if step > 2.0 * h:
+                step = 2.0 * h
+        if t >= L or fl - (L - t) - r >= bound:
+            break
         t += step
         if t > L:
             t = L
@@ -669,8 +697,10 @@ def separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, 
         t = ts[m]
         px, py, pz = ra[c, 0] + t * (rb[c, 0] - ra[c, 0]), ra[c, 1] + t * (rb[c, 1] - ra[c, 1]), \
             ra[c, 2] + t * (rb[c, 2] - ra[c, 2])
-        d = _reach_value(reach, origin, grid_h, arm_len, fences, near, sh, tr, side, n_near,
-                        px, py, pz) - r
+        f = _reach_field(reach, origin, grid_h, sh, tr, side, px, py, pz)
+        if n_near > 0 and f - r < best:  # (the fenced value is never below f: else it cannot be a new best)
+            f = _fence_value(arm_len, fences, near, sh, side, n_near, f, px, py, pz, best + r)
+        d = f - r
         if d < best:
             best, best_cap, best_part = d, c, PART_LEFT_REACH + side
             row[M_RX], row[M_RY], row[M_RZ] = px, py, pz
@@ -747,7 +777,7 @@ def separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, 
 
 # Not inlined: it is called from three entry points, and numba's IR inlining of this much nested code made a
 # cold compile take 5 minutes instead of under 2 (for about 5 % of run time on baseline).
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def sense_and_measure(P, state, W, row, action):
     """At the state's time: devices latch stops, the robot is posed, d_HR and v_R are measured."""
     dt = P.scal[C_DT]
@@ -804,7 +834,7 @@ def reset_state(P, x, y, heading, state, W, row):
     sense_and_measure(P, state, W, row, -1)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def step_action(P, state, action, W, out, row0):
     """Play one action (P.spa time steps) from ``state`` in place; rows go to out[row0:]. Returns rows written.
 
