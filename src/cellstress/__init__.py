@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-__version__ = "0.1.0"
+__version__ = "0.3.0"
 
 __all__ = ["BUILTIN_CELLS", "Cell", "Simulator", "__version__", "load_cell", "search"]
 
