@@ -423,6 +423,12 @@ def _edge_detour(sx, sy, sz, qx, qy, qz, ex, ey, ez, dx, dy, dz, length):
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def _path_clear(fences, near, n_near, ax, ay, az, bx, by, bz):
     """No near fence panel lies across the straight segment a-b."""
+    return _blocking_panel(fences, near, n_near, ax, ay, az, bx, by, bz) < 0
+
+
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def _blocking_panel(fences, near, n_near, ax, ay, az, bx, by, bz):
+    """The index into ``near`` of the first near fence panel across the straight segment a-b, or -1."""
     for m in range(n_near):
         i = near[m]
         ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
@@ -435,8 +441,29 @@ def _path_clear(fences, near, n_near, ax, ay, az, bx, by, bz):
         cx, cy, cz = ax + t * (bx - ax), ay + t * (by - ay), az + t * (bz - az)
         u = ((cx - fences[i, 0]) * ux + (cy - fences[i, 1]) * uy) / (ux * ux + uy * uy)
         if 0.0 <= u <= 1.0 and fences[i, 4] <= cz <= fences[i, 5]:
-            return False
-    return True
+            return m
+    return -1
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _around_panel(fences, i, sx, sy, sz, qx, qy, qz):
+    """A lower bound on any path from s to q that passes panel i, when the straight path crosses it.
+
+    The path must cross the panel's plane outside the panel, and |s - c| + |c - q| over the plane is convex
+    with its minimum inside the panel, so the shortest such crossing lies on the panel's border: the least
+    of the four edge detours (the bottom edge included, though going under a panel on the floor is not
+    possible: a weaker bound is still a bound)."""
+    ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
+    w = np.sqrt(ux * ux + uy * uy)
+    ux /= w
+    uy /= w
+    lb = _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 5], ux, uy, 0.0, w)[0]
+    lb = min(lb, _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 4], ux, uy, 0.0, w)[0])
+    height = fences[i, 5] - fences[i, 4]
+    lb = min(lb, _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 4], 0.0, 0.0, 1.0,
+                              height)[0])
+    return min(lb, _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 2], fences[i, 3], fences[i, 4], 0.0, 0.0, 1.0,
+                                height)[0])
 
 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
@@ -445,9 +472,13 @@ def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff=np.inf):
     edge or around their ends (inf if every such path is blocked); |s - q| when nothing is in the way.
 
     A finite ``cutoff`` says that any length from it up will do: the result is exact below it and ``cutoff``
-    otherwise, and bends that are not shorter are not checked for crossings (most of the cost)."""
-    if _path_clear(fences, near, n_near, sx, sy, sz, qx, qy, qz):
+    otherwise, and bends that are not shorter are not checked for crossings (most of the cost). If even the
+    way around the first panel in the way is that long, no bend is looked at."""
+    blocking = _blocking_panel(fences, near, n_near, sx, sy, sz, qx, qy, qz)
+    if blocking < 0:
         return np.sqrt((sx - qx) ** 2 + (sy - qy) ** 2 + (sz - qz) ** 2)
+    if cutoff < np.inf and _around_panel(fences, near[blocking], sx, sy, sz, qx, qy, qz) - 1e-9 >= cutoff:
+        return cutoff
     best = cutoff
     nudge = 0.01  # step the bend point off the panel so the crossing tests are not degenerate
     for m in range(n_near):
