@@ -315,17 +315,25 @@ def search(
     distinct: Annotated[bool, typer.Option("--distinct", help="With --until budget: cluster the hazards "
                                            "into classes, steer away from classes found, list each (evolve: "
                                            "the budget shared between the start points in slices).")] = False,
+    settings: Annotated[list[str] | None, typer.Option("--set", help="Any other option of the searcher, "
+                                                       "NAME=VALUE, repeated (e.g. --set pool=5 --set "
+                                                       "score=risk for evolve; its docstring lists them).")] = None,
 ) -> None:
     """Search a cell for a sequence of worker actions that ends in an unsafe contact; write result.json
     and its report (see 'cellstress report')."""
     import time
 
-    from cellstress.search import make_searcher
+    from cellstress.search import make_searcher, parse_options
     from cellstress.search import search as run
     from cellstress.search.common import check_common
 
     options = {name: v for name, v in (("ec", ec), ("k", k), ("alpha", alpha), ("n", n)) if v is not None}
     with _user_errors():
+        extra = parse_options(settings)
+        twice = sorted(set(extra) & set(options))
+        if twice:
+            raise CellstressError(f"--set {twice[0]}: given as --{twice[0]} too")
+        options.update(extra)
         check_common(budget, seed, until, top_k)
         make_searcher(searcher, **options)
         _check_criterion(criterion)

@@ -141,6 +141,24 @@ def test_changed_options_are_one_clear_error(done, tmp_path, capsys, change, say
     assert (out / RUNS).read_bytes() == before
 
 
+def test_set_goes_to_the_searchers_that_have_the_option_and_is_pinned(done, tmp_path, capsys):
+    """--set ec=0.8 reaches mcts (it has ec), not random; the manifest and every run record it, and resuming
+    with another value is refused."""
+    out = tmp_path / "set"
+    assert main(["campaign", *SMALL, "--set", "ec=0.8", "--out", str(out)]) == 0
+    doc = json.loads((out / MANIFEST).read_text())
+    params = {s["name"]: s["params"] for s in doc["searchers"]}
+    assert params["mcts"]["ec"] == 0.8 and "ec" not in params["random"]
+    runs = [json.loads(line) for line in (out / RUNS).read_text().splitlines()]
+    assert {r["params"].get("ec") for r in runs if r["searcher"] == "mcts"} == {0.8}
+    default = [json.loads(line) for line in (done / RUNS).read_text().splitlines()]
+    assert {r["params"]["ec"] for r in default if r["searcher"] == "mcts"} == {0.5}
+    capsys.readouterr()
+    code = main(["campaign", *SMALL, "--set", "ec=0.9", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and "searcher mcts's options differ" in err and "ec 0.8 there, 0.9 here" in err, err
+
+
 def test_workers_and_backend_are_not_options_of_the_experiment(done, tmp_path, capsys):
     out = _copy(done, tmp_path / "w2")
     code = main(["campaign", *_options(workers="2"), "--out", str(out)])
@@ -195,6 +213,10 @@ def test_two_campaigns_cannot_share_a_folder(done, tmp_path, capsys):
     (["--workers", "0"], "--workers must be a whole number >= 1"),
     (["--backend", "dask"], "--backend must be one of processes, ray"),
     (["--address", "auto"], "use it with --backend ray"),
+    (["--set", "ec"], "--set 'ec': expected NAME=VALUE"),
+    (["--set", "pool=5"], "--set pool: none of the searchers (random, mcts, mcts-commit) has this option"),
+    (["--set", "ec=-1"], "--set: "),
+    (["--set", "ec=1", "--set", "ec=2"], "option 'ec' given twice"),
 ])
 def test_bad_options(tmp_path, capsys, args, says):
     code = main(["campaign", "--out", str(tmp_path / "x"), *args])

@@ -141,3 +141,25 @@ def test_search_and_replay_a_cell_file_from_another_folder(tmp_path, capsys, mon
 def test_out_is_required(capsys) -> None:
     code, _, err = _run(["search", "s1-scanner-width"], capsys)
     assert code == 2 and err.startswith("error: Missing option '--out'") and err.count("\n") == 1
+
+
+def test_set_passes_any_searcher_option(tmp_path, capsys) -> None:
+    """--set NAME=VALUE reaches the searcher (JSON values, else text) and is recorded in result.json."""
+    code, _, err = _run(["search", "s1-scanner-width", "-s", "evolve", "--budget", "30", "--no-report",
+                         "--set", "pool=2", "--set", "score=risk", "--set", "sticky=0.5", "--out", str(tmp_path)],
+                        capsys)
+    assert code == 0, err
+    params = json.loads((tmp_path / "result.json").read_text())["params"]
+    assert (params["pool"], params["score"], params["sticky"]) == (2, "risk", 0.5)
+
+
+@pytest.mark.parametrize(("args", "says"), [
+    (["-s", "evolve", "--set", "pool=abc"], "pool must be a whole number >= 1, not 'abc'"),
+    (["-s", "mcts", "--set", "pool=2"], "searcher 'mcts' has no option pool"),
+    (["-s", "mcts", "--set", "ec=1", "--ec", "2"], "--set ec: given as --ec too"),
+    (["--set", "oops"], "--set 'oops': expected NAME=VALUE"),
+])
+def test_bad_set_options(tmp_path, capsys, args, says) -> None:
+    code, _, err = _run(["search", "s1-scanner-width", *args, "--out", str(tmp_path / "x")], capsys)
+    assert code == 2 and err.startswith("error: ") and err.count("\n") == 1 and says in err, err
+    assert not (tmp_path / "x" / "result.json").exists()

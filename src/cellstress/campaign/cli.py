@@ -20,7 +20,7 @@ def campaign(
                                                     "comma-separated or repeated. Default: s1-scanner-width, "
                                                     "s2-elbow-intrusion, s3-fence-gap.")] = None,
     searchers: Annotated[list[str] | None, typer.Option("--searchers", help="Searchers, comma-separated or "
-                                                        "repeated, with their default options. Default: "
+                                                        "repeated, with their default options (see --set). Default: "
                                                         "random, mcts, mcts-commit.")] = None,
     seeds: Annotated[int, typer.Option("--seeds", help="Seeds per cell and searcher: 0 .. N-1.")] = 10,
     budget: Annotated[int, typer.Option("--budget", "-b", help="Episodes per run; a run stops at its first "
@@ -31,6 +31,9 @@ def campaign(
     backend: Annotated[str, typer.Option("--backend", help="processes (local) or ray.")] = "processes",
     address: Annotated[str | None, typer.Option("--address", help="Ray cluster address (e.g. auto, "
                                                 "ray://head:10001); default: a local Ray.")] = None,
+    settings: Annotated[list[str] | None, typer.Option("--set", help="A searcher option, NAME=VALUE, "
+                                                       "repeated; it applies to every listed searcher that "
+                                                       "has it (e.g. --set score=all for evolve).")] = None,
 ) -> None:
     """Run the Table III experiment (cells x searchers x seeds) in parallel; write runs.jsonl and the table.
 
@@ -43,12 +46,13 @@ def campaign(
     from cellstress.campaign.plan import split_names
     from cellstress.campaign.table import TABLE_CSV, TABLE_MD, markdown
     from cellstress.cli import _check_out_dir, _fail, _user_errors
+    from cellstress.search import parse_options
 
     with _user_errors():
         how = Backend(backend, workers, address)
         how.check()
         plan = resolve(split_names(cells, DEFAULT_CELLS, "cells"), split_names(searchers, DEFAULT_SEARCHERS,
-                       "searchers"), seeds, budget)
+                       "searchers"), seeds, budget, parse_options(settings))
     out_dir: Path = _check_out_dir(out)
 
     from rich.console import Console

@@ -112,11 +112,13 @@ def split_names(values: list[str] | tuple[str, ...] | None, default: tuple[str, 
     return names
 
 
-def resolve(cells: tuple[str, ...], searchers: tuple[str, ...], seeds: int, budget: int) -> CampaignPlan:
+def resolve(cells: tuple[str, ...], searchers: tuple[str, ...], seeds: int, budget: int,
+            options: dict[str, Any] | None = None) -> CampaignPlan:
     """Check the options and pin them: load every cell (its hash) and fill in each searcher's defaults.
+    ``options`` (``--set``) go to every searcher that has them; each must belong to at least one.
 
     Raises ``CampaignError`` (or the cell's ``CellError``) for anything the user must fix."""
-    from dataclasses import asdict
+    from dataclasses import asdict, fields
 
     from cellstress import __version__
     from cellstress.cell.load import BUILTIN_CELLS, load_cell
@@ -141,7 +143,19 @@ def resolve(cells: tuple[str, ...], searchers: tuple[str, ...], seeds: int, budg
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise CampaignError(f"--cells: two cells are named {twice[0]!r}; rows of the table are keyed by name")
-    srefs = tuple(SearcherRef(s, tuple(sorted(asdict(make_searcher(s)).items()))) for s in searchers)
+    options = dict(options or {})
+    has = {s: {f.name for f in fields(SEARCHERS[s])} for s in searchers}
+    orphans = sorted(o for o in options if not any(o in has[s] for s in searchers))
+    if orphans:
+        raise CampaignError(f"--set {orphans[0]}: none of the searchers ({', '.join(searchers)}) has this option")
+    srefs = []
+    for s in searchers:
+        try:
+            searcher = make_searcher(s, **{o: v for o, v in options.items() if o in has[s]})
+        except CellstressError as exc:
+            raise CampaignError(f"--set: {exc}") from None
+        srefs.append(SearcherRef(s, tuple(sorted(asdict(searcher).items()))))
+    srefs = tuple(srefs)
     return CampaignPlan(tuple(refs), srefs, int(seeds), int(budget), __version__)
 
 
@@ -171,8 +185,11 @@ def manifest_difference(old: dict[str, Any], new: dict[str, Any]) -> str | None:
                 f"{_show([s['name'] for s in new_s])} here")
     for a, b in zip(old_s, new_s, strict=True):
         if a.get("params") != b["params"]:
-            return (f"searcher {b['name']}'s default options have changed ({_show(a.get('params'))} there, "
-                    f"{_show(b['params'])} here)")
+            pa, pb = a.get("params") or {}, b["params"]
+            diff = sorted(k for k in set(pa) | set(pb) if pa.get(k, "(none)") != pb.get(k, "(none)"))
+            return (f"searcher {b['name']}'s options differ (--set, or a changed default): "
+                    + ", ".join(f"{k} {_show(pa.get(k, '(none)'))} there, {_show(pb.get(k, '(none)'))} here"
+                                for k in diff))
     if old.get("seeds") != new["seeds"]:
         return f"--seeds differs: {len(old.get('seeds') or [])} there, {len(new['seeds'])} here"
     for key, label in (("budget", "--budget"), ("until", "until"), ("cellstress_version", "cellstress version")):

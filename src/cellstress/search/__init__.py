@@ -34,8 +34,28 @@ DEFAULT_BUDGET = 200
 DEFAULT_TOP_K = 10
 
 __all__ = ["SEARCHERS", "UNTIL", "Episode", "Evolve", "MCTS", "MCTSCommit", "Outcome", "Problem", "RandomSearch",
-           "Recorder", "Reward", "SearchError", "SearchResult", "SimProblem", "make_searcher", "run_search",
-           "search"]
+           "Recorder", "Reward", "SearchError", "SearchResult", "SimProblem", "make_searcher", "parse_options",
+           "run_search", "search"]
+
+
+def parse_options(settings: list[str] | tuple[str, ...] | None, flag: str = "--set") -> dict:
+    """``["pool=5", "score=risk"]`` -> ``{"pool": 5, "score": "risk"}``: each VALUE is read as JSON (numbers,
+    true/false, null, quoted strings), else taken as plain text. SearchError for a malformed or repeated one."""
+    import json
+
+    out: dict = {}
+    for item in settings or ():
+        name, sep, text = str(item).partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise SearchError(f"{flag} {item!r}: expected NAME=VALUE (e.g. {flag} pool=5)")
+        if name in out:
+            raise SearchError(f"{flag}: option {name!r} given twice")
+        try:
+            out[name] = json.loads(text)
+        except ValueError:
+            out[name] = text.strip()
+    return out
 
 
 def make_searcher(name: str, **options):
