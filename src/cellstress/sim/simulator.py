@@ -177,6 +177,8 @@ class Simulator:
                 rows = rows[:i + 1]
                 rows[i, K.M_UNSAFE] = 1.0
                 nxt[K.S_UNSAFE] = 1.0
+                if i < n - 1:
+                    _state_at(nxt, state, rows, self.params.dev_resp)
         return nxt, rows
 
     @staticmethod
@@ -250,6 +252,25 @@ class Simulator:
                 v_end[e, played:] = np.nan
                 min_d[e] = rows[1:, K.M_D].min()
         return BatchResult(d_end, v_end, unsafe_step, min_d)
+
+
+def _state_at(nxt: np.ndarray, before: np.ndarray, rows: np.ndarray, resp: np.ndarray) -> None:
+    """Turn ``nxt``, the state at the end of an action played from ``before``, into the state at the step of
+    ``rows[-1]``, where a criterion ended the episode: the clock and pose from that row, and the stop latch
+    replayed from the devices each row saw, as ``kernels.sense_and_measure`` latches it."""
+    row = rows[-1]
+    nxt[K.S_K] = row[K.M_STEP]
+    nxt[K.S_X], nxt[K.S_Y], nxt[K.S_HEADING] = row[K.M_X], row[K.M_Y], row[K.M_HEADING]
+    nxt[K.S_FWD], nxt[K.S_LAT] = row[K.M_FWD], row[K.M_LAT]
+    nxt[K.S_TSTOP], nxt[K.S_TRIG_DEV], nxt[K.S_TRIG_T] = before[K.S_TSTOP], before[K.S_TRIG_DEV], before[K.S_TRIG_T]
+    for r in rows:
+        seen, t = int(r[K.M_SEEN]), r[K.M_T]
+        for d in range(len(resp)):
+            if seen >> d & 1 and t + resp[d] < nxt[K.S_TSTOP]:
+                nxt[K.S_TSTOP] = t + resp[d]
+                if nxt[K.S_TRIG_DEV] < 0:
+                    nxt[K.S_TRIG_T] = t
+                nxt[K.S_TRIG_DEV] = d
 
 
 def _force_model(layout: Layout):
