@@ -2,20 +2,14 @@
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "curtain_probe.py"
+from cellstress.sim.probe import probe
 
 
 @pytest.mark.slow
 def test_no_worker_standing_behind_the_s2_curtain_is_reached():
-    spec = importlib.util.spec_from_file_location("curtain_probe", SCRIPT)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    r = mod.probe("s2-elbow-intrusion", 0.05)
+    r = probe("s2-elbow-intrusion", 0.05)
     assert (r["poses"], r["unseen"], r["robot_poses"]) == (14400, 4500, 250)
     # the figure docs/cells.md gives: the robot stays 0.262 m outside the reach of every unseen standing pose
     assert r["d"] == pytest.approx(0.262, abs=0.0005)
