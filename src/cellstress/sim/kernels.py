@@ -730,7 +730,8 @@ def separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, 
             ra[c, 2] + t * (rb[c, 2] - ra[c, 2])
         f = _reach_field(reach, origin, grid_h, sh, tr, side, px, py, pz)
         if n_near > 0 and f - r < best:  # (the fenced value is never below f: else it cannot be a new best)
-            f = _fence_value(arm_len, fences, near, sh, side, n_near, f, px, py, pz, best + r)
+            # (cutoff h above the best: a stand-in value must not round below it and pass for a new best)
+            f = _fence_value(arm_len, fences, near, sh, side, n_near, f, px, py, pz, best + r + grid_h)
         d = f - r
         if d < best:
             best, best_cap, best_part = d, c, PART_LEFT_REACH + side
