@@ -2,11 +2,15 @@
 
     python scripts/kernel_reference.py record FILE.npz [--episodes 20000]
     python scripts/kernel_reference.py check FILE.npz
+    python scripts/kernel_reference.py compare OLD.npz NEW.npz
 
 For each built-in reference cell: every ``run_batch`` output for random actions (numpy Generator, seed 123),
 200 whole traces (``Simulator.run``), 300 episodes played through ``Simulator.step``, s0 and its metric row.
 Use it around a speed change that must not change results: record before, check after (exit 1 on any
-difference, which it lists).
+difference, which it lists). Around a change that may move d_HR within the trace's tolerance, record before
+and after and ``compare``: per cell, whether the unsafe episodes and steps are the same, how far d_HR moved
+(absolute and relative), whether any row within 5 cm of contact changed, and how many rows changed their
+closest link or body part.
 """
 
 from __future__ import annotations
@@ -53,10 +57,41 @@ def same_bits(a: np.ndarray, b: np.ndarray) -> bool:
     return np.array_equal(a, b)
 
 
+def compare(old: dict, new: dict) -> int:
+    """Print how far NEW's outputs moved from OLD's; 1 if the unsafe outcomes differ."""
+    from cellstress.sim import kernels as K
+
+    changed_outcome = False
+    for c in CELLS:
+        same_unsafe = np.array_equal(old[f"{c}:unsafe_step"], new[f"{c}:unsafe_step"])
+        a, b = old[f"{c}:d_end"], new[f"{c}:d_end"]
+        ok = np.isfinite(a) & np.isfinite(b)
+        dd = np.abs(a[ok] - b[ok])
+        rel = dd / np.maximum(np.abs(a[ok]), 1e-9)
+        rows_old = np.concatenate([old[f"{c}:run{i}"] for i in range(200)] + [old[f"{c}:step{i}"] for i in range(300)])
+        rows_new = np.concatenate([new[f"{c}:run{i}"] for i in range(200)] + [new[f"{c}:step{i}"] for i in range(300)])
+        if rows_old.shape != rows_new.shape:
+            print(f"{c}: traces differ in length")
+            changed_outcome = True
+            continue
+        dr = np.abs(rows_old[:, K.M_D] - rows_new[:, K.M_D])
+        near = (rows_old[:, K.M_D] < 0.05) | (rows_new[:, K.M_D] < 0.05)
+        who = (rows_old[:, K.M_LINK] != rows_new[:, K.M_LINK]) | (rows_old[:, K.M_PART] != rows_new[:, K.M_PART])
+        n_unsafe = int((new[f"{c}:unsafe_step"] >= 0).sum())
+        print(f"{c}: unsafe episodes {'same' if same_unsafe else 'DIFFER'} ({n_unsafe} of {len(a)}); "
+              f"d_end moved in {int((dd > 0).sum())} of {dd.size} (max {dd.max(initial=0):.2e} m, "
+              f"max rel {rel.max(initial=0):.2%}); trace rows: d moved in {int((dr > 0).sum())} of {dr.size} "
+              f"(max {dr.max(initial=0):.2e} m), within 5 cm of contact {int((dr[near] > 0).sum())}, "
+              f"closest link/part changed in {int(who.sum())}")
+        changed_outcome |= not same_unsafe
+    return 1 if changed_outcome else 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("mode", choices=("record", "check"))
+    ap.add_argument("mode", choices=("record", "check", "compare"))
     ap.add_argument("file")
+    ap.add_argument("new", nargs="?", help="compare: the second recording")
     ap.add_argument("--episodes", type=int, default=20_000)
     args = ap.parse_args(argv)
     if args.mode == "record":
@@ -64,6 +99,10 @@ def main(argv=None) -> int:
         np.savez(args.file, **out)
         print(f"recorded {len(out)} arrays in {args.file}")
         return 0
+    if args.mode == "compare":
+        if args.new is None:
+            ap.error("compare needs OLD.npz NEW.npz")
+        return compare(np.load(args.file), np.load(args.new))
     ref = np.load(args.file)
     n = len(ref["baseline:d_end"])
     out = outputs(n)

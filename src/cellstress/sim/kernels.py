@@ -426,21 +426,26 @@ def _path_clear(fences, near, n_near, ax, ay, az, bx, by, bz):
     return _blocking_panel(fences, near, n_near, ax, ay, az, bx, by, bz) < 0
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _panel_across(fences, i, ax, ay, az, bx, by, bz):
+    """Fence panel i lies across the straight segment a-b."""
+    ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
+    nx, ny = -uy, ux
+    sa = (ax - fences[i, 0]) * nx + (ay - fences[i, 1]) * ny
+    sb = (bx - fences[i, 0]) * nx + (by - fences[i, 1]) * ny
+    if sa * sb >= 0.0:
+        return False
+    t = sa / (sa - sb)
+    cx, cy, cz = ax + t * (bx - ax), ay + t * (by - ay), az + t * (bz - az)
+    u = ((cx - fences[i, 0]) * ux + (cy - fences[i, 1]) * uy) / (ux * ux + uy * uy)
+    return 0.0 <= u <= 1.0 and fences[i, 4] <= cz <= fences[i, 5]
+
+
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def _blocking_panel(fences, near, n_near, ax, ay, az, bx, by, bz):
     """The index into ``near`` of the first near fence panel across the straight segment a-b, or -1."""
     for m in range(n_near):
-        i = near[m]
-        ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
-        nx, ny = -uy, ux
-        sa = (ax - fences[i, 0]) * nx + (ay - fences[i, 1]) * ny
-        sb = (bx - fences[i, 0]) * nx + (by - fences[i, 1]) * ny
-        if sa * sb >= 0.0:
-            continue
-        t = sa / (sa - sb)
-        cx, cy, cz = ax + t * (bx - ax), ay + t * (by - ay), az + t * (bz - az)
-        u = ((cx - fences[i, 0]) * ux + (cy - fences[i, 1]) * uy) / (ux * ux + uy * uy)
-        if 0.0 <= u <= 1.0 and fences[i, 4] <= cz <= fences[i, 5]:
+        if _panel_across(fences, near[m], ax, ay, az, bx, by, bz):
             return m
     return -1
 
@@ -466,19 +471,24 @@ def _around_panel(fences, i, sx, sy, sz, qx, qy, qz):
                                 height)[0])
 
 
-@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
-def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff=np.inf):
-    """Length of the shortest arm path from shoulder s to q around the near fence panels, over their top
-    edge or around their ends (inf if every such path is blocked); |s - q| when nothing is in the way.
+@njit(cache=True, error_model="numpy", inline="always")
+def _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
+    """(fence_detour's length, a lower bound of it that moves by at most |dq| with q).
 
-    A finite ``cutoff`` says that any length from it up will do: the result is exact below it and ``cutoff``
-    otherwise, and bends that are not shorter are not checked for crossings (most of the cost). If even the
-    way around the first panel in the way is that long, no bend is looked at."""
-    blocking = _blocking_panel(fences, near, n_near, sx, sy, sz, qx, qy, qz)
-    if blocking < 0:
-        return np.sqrt((sx - qx) ** 2 + (sy - qy) ** 2 + (sz - qz) ** 2)
-    if cutoff < np.inf and _around_panel(fences, near[blocking], sx, sy, sz, qx, qy, qz) - 1e-9 >= cutoff:
-        return cutoff
+    The bound is |s - q| where nothing is in the way, else the largest ``_around_panel`` of the panels in
+    the way (every way round must pass each of them). Each term is 1-Lipschitz in q, and a panel's term
+    equals |s - q| where q's straight path starts or stops crossing it (at the panel's border), so the bound
+    is continuous and 1-Lipschitz except where q itself passes through a panel, where it can drop."""
+    around = -1.0
+    for m in range(n_near):
+        if _panel_across(fences, near[m], sx, sy, sz, qx, qy, qz):
+            a = _around_panel(fences, near[m], sx, sy, sz, qx, qy, qz)
+            around = a if a > around else around
+    if around < 0.0:
+        d = np.sqrt((sx - qx) ** 2 + (sy - qy) ** 2 + (sz - qz) ** 2)
+        return d, d
+    if cutoff < np.inf and around - 1e-9 >= cutoff:
+        return cutoff, around
     best = cutoff
     nudge = 0.01  # step the bend point off the panel so the crossing tests are not degenerate
     for m in range(n_near):
@@ -502,7 +512,24 @@ def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff=np.inf):
             if (length < best and _path_clear(fences, near, n_near, sx, sy, sz, ex, ey, ez)
                     and _path_clear(fences, near, n_near, ex, ey, ez, qx, qy, qz)):
                 best = length
-    return best
+    return best, around
+
+
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff=np.inf):
+    """Length of the shortest arm path from shoulder s to q around the near fence panels, over their top
+    edge or around their ends (inf if every such path is blocked); |s - q| when nothing is in the way.
+
+    A finite ``cutoff`` says that any length from it up will do: the result is exact below it and ``cutoff``
+    otherwise, and bends that are not shorter are not checked for crossings (most of the cost). If even the
+    way around one of the panels in the way is that long, no bend is looked at."""
+    return _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff)[0]
+
+
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def fence_detour_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
+    """``fence_detour`` and its 1-Lipschitz lower bound (see ``_detour_and_bound``)."""
+    return _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -571,16 +598,26 @@ def reach_to_segment(reach, origin, h, arm_len, fences, near, sh, tr, side, n_ne
     L = np.sqrt((bx - ax) ** 2 + (by - ay) ** 2 + (bz - az) ** 2)
     best = np.inf
     t = 0.0
+    # Does the axis pass through a near panel? (Not for a robot inside its fence; if it does, the detour's
+    # bound may drop there faster than the axis moves, and the trace below does not lean on that bound.)
+    through = n_near > 0 and _blocking_panel(fences, near, n_near, ax, ay, az, bx, by, bz) >= 0
+    sx, sy, sz = sh[side, 0], sh[side, 1], sh[side, 2]
     while True:
         tt = t / L if L > 0.0 else 0.0
         px, py, pz = ax + tt * (bx - ax), ay + tt * (by - ay), az + tt * (bz - az)
         fl = _reach_field(reach, origin, h, sh, tr, side, px, py, pz)
         f = fl
+        lb = fl
         # The fenced value is never below fl, so where fl >= best it cannot be a new best, and where
         # fl >= bound + r it cannot matter to the caller (which ignores results >= bound): skip the detour.
-        # Nor does its exact value from bound + r + h up: it is no new best then, and the stride below is 2 h.
+        # Nor does its exact value from bound + r + h up: it is no new best then, and the steps below use
+        # only its lower bound there.
         if n_near > 0 and fl < best and fl < bound + r:
-            f = _fence_value(arm_len, fences, near, sh, side, n_near, fl, px, py, pz, bound + r + h)
+            g, g_lb = fence_detour_bound(fences, near, n_near, sx, sy, sz, px, py, pz, bound + r + h + arm_len)
+            g -= arm_len
+            g_lb -= arm_len
+            f = g if g > f else f
+            lb = g_lb if g_lb > lb else lb
         if f < best:
             best = f
             out_q[0], out_q[1], out_q[2] = px, py, pz
@@ -591,11 +628,17 @@ def reach_to_segment(reach, origin, h, arm_len, fences, near, sh, tr, side, n_ne
             # the axis from below: no point within this step can undercut min(best, bound) by more than h + slack.
             step = fl - target + h + slack
         else:
-            # A panel holds the hand back here (fl < target <= f): the fenced value jumps where the hand's
-            # way round changes, so walk in strides of at most 2 h, as on its own it would need.
+            # A panel holds the hand back here (fl < target <= f). The fenced value jumps where the hand's
+            # way round changes, so walk in strides of at most 2 h, as on its own it would need; but the
+            # detour's lower bound is 1-Lipschitz along an axis that does not pass through a panel, so where
+            # that bound is far above the target the stride can be as long as it is.
             step = f - target + h + slack
             if step > 2.0 * h:
                 step = 2.0 * h
+            if not through:
+                long_step = lb - target + h + slack
+                if long_step > step:
+                    step = long_step
         if t >= L or fl - (L - t) - r >= bound:
             break
         t += step
