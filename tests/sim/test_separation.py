@@ -1,6 +1,7 @@
 """d_HR as the kernel measures it, against brute force: every robot capsule axis sampled every 2 mm, each sample's
 exact fenced reach value (``kernels.reach_value``: the reach field, and the hand's detour around the near panels),
-and the body capsules by exact segment distances.
+and the body capsules by exact segment distances; and the closest (robot capsule, body part) pair it names
+against that pair's own brute-force minimum.
 
 The kernel sphere-traces the axes and skips the detour where it cannot matter, so it must never report less
 than the true minimum (up to the brute force's own sampling error) and never more than its stated tolerance:
@@ -23,24 +24,25 @@ from cellstress.sim.simulator import Simulator
 SAMPLE = 0.002  # brute-force spacing along a capsule axis (m)
 
 
-def brute_force_d(sim: Simulator, row: np.ndarray) -> tuple[float, int]:
-    """(d_HR by brute force, number of fence panels near the shoulders) for one metric row."""
+def brute_force_d(sim: Simulator, row: np.ndarray) -> tuple[float, int, dict[tuple[int, int], float]]:
+    """(d_HR by brute force, number of fence panels near the shoulders, the minimum of each (robot capsule,
+    body part) pair) for one metric row."""
     P = sim.params
     W = K.make_work(P)
     K.human_pose(P, row[K.M_X], row[K.M_Y], row[K.M_HEADING], row[K.M_FWD], row[K.M_LAT], W)
     n_near = int(K.near_fences(P, W, P.body[K.B_ARM_LEN] + 0.05))
     ra, rb = scene.robot_capsules(sim.layout, row[K.M_TAU])
-    best = np.inf
+    pairs: dict[tuple[int, int], float] = {}
     for c in range(len(P.cap_r)):
         r = float(P.cap_r[c])
         n = max(2, int(np.linalg.norm(rb[c] - ra[c]) / SAMPLE) + 1)
-        for p in np.linspace(ra[c], rb[c], n):
-            for side in (0, 1):
-                best = min(best, float(K.reach_value(P, p, side, W, n_near)) - r)
+        for side in (0, 1):
+            pairs[c, K.PART_LEFT_REACH + side] = min(float(K.reach_value(P, p, side, W, n_near)) - r
+                                                     for p in np.linspace(ra[c], rb[c], n))
         for h in range(K.N_BODY_CAPSULES):
             d2 = segment_segment_xyz(*ra[c], *rb[c], *W.ha[h], *W.hb[h])[0]
-            best = min(best, math.sqrt(d2) - r - float(W.hr[h]))
-    return best, n_near
+            pairs[c, h] = math.sqrt(d2) - r - float(W.hr[h])
+    return min(pairs.values()), n_near, pairs
 
 
 def sampled_rows(sim: Simulator, episodes: int, seed: int) -> list[np.ndarray]:
@@ -60,10 +62,13 @@ def test_kernel_d_hr_matches_brute_force(cell):
     h = float(sim.params.scal[K.C_REACH_H])
     near_checked = 0
     for row in sampled_rows(sim, 40, seed=5):
-        brute, n_near = brute_force_d(sim, row)
+        brute, n_near, pairs = brute_force_d(sim, row)
         near_checked += n_near > 0
         d = float(row[K.M_D])
         step = int(row[K.M_STEP])
+        # the closest robot link and body part it names really come that close (a stand-in value that passed
+        # for a new best named the wrong pair in session 3, with d still right)
+        assert pairs[int(row[K.M_LINK]), int(row[K.M_PART])] <= max(d, 0.0) + SAMPLE, (step, d, pairs)
         if brute <= 0.0:
             assert d == 0.0, (step, brute)
             continue
