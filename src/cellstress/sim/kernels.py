@@ -452,24 +452,37 @@ def _blocking_panel(fences, near, n_near, ax, ay, az, bx, by, bz):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _around_panel(fences, i, sx, sy, sz, qx, qy, qz):
-    """A lower bound on any path from s to q that passes panel i, when the straight path crosses it.
-
-    The path must cross the panel's plane outside the panel, and |s - c| + |c - q| over the plane is convex
-    with its minimum inside the panel, so the shortest such crossing lies on the panel's border: the least
-    of the four edge detours (the bottom edge included, though going under a panel on the floor is not
-    possible: a weaker bound is still a bound)."""
+def _panel_edges(fences, i, sx, sy, sz, qx, qy, qz):
+    """The shortest paths s -> e -> q over panel i's top edge and around its two end edges, as (length,
+    position along the edge) each: (top, t_top, first end, t_first, second end, t_second)."""
     ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
     w = np.sqrt(ux * ux + uy * uy)
     ux /= w
     uy /= w
-    lb = _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 5], ux, uy, 0.0, w)[0]
-    lb = min(lb, _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 4], ux, uy, 0.0, w)[0])
+    top, t_top = _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 5], ux, uy, 0.0, w)
     height = fences[i, 5] - fences[i, 4]
-    lb = min(lb, _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 4], 0.0, 0.0, 1.0,
-                              height)[0])
-    return min(lb, _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 2], fences[i, 3], fences[i, 4], 0.0, 0.0, 1.0,
-                                height)[0])
+    end0, t0 = _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 4], 0.0, 0.0, 1.0, height)
+    end1, t1 = _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 2], fences[i, 3], fences[i, 4], 0.0, 0.0, 1.0, height)
+    return top, t_top, end0, t0, end1, t1
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _around_panel(fences, i, sx, sy, sz, qx, qy, qz, top, end0, end1):
+    """A lower bound on any path from s to q that passes panel i, when the straight path crosses it, given
+    the panel's edge detours ``top``, ``end0``, ``end1`` (``_panel_edges``).
+
+    The path must cross the panel's plane outside the panel, and |s - c| + |c - q| over the plane is convex
+    with its minimum inside the panel, so the shortest such crossing lies on the panel's border: the least
+    of the four edge detours. The bottom edge counts only if s or q lies at or below it: otherwise a path
+    below the panel would have to dip under the panel and come back up, and the segment from such a crossing
+    to the straight path's crossing enters the panel through an end edge or the top, at no greater length."""
+    lb = min(top, end0, end1)
+    if fences[i, 4] < min(sz, qz):
+        return lb
+    ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
+    w = np.sqrt(ux * ux + uy * uy)
+    return min(lb, _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 4], ux / w, uy / w,
+                                0.0, w)[0])
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -481,10 +494,16 @@ def _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
     equals |s - q| where q's straight path starts or stops crossing it (at the panel's border), so the bound
     is continuous and 1-Lipschitz except where q itself passes through a panel, where it can drop."""
     around = -1.0
+    first = -1  # the first panel in the way: its edge detours are reused below
+    first_edges = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     for m in range(n_near):
         if _panel_across(fences, near[m], sx, sy, sz, qx, qy, qz):
-            a = _around_panel(fences, near[m], sx, sy, sz, qx, qy, qz)
+            e = _panel_edges(fences, near[m], sx, sy, sz, qx, qy, qz)
+            a = _around_panel(fences, near[m], sx, sy, sz, qx, qy, qz, e[0], e[2], e[4])
             around = a if a > around else around
+            if first < 0:
+                first = m
+                first_edges = e
     if around < 0.0:
         d = np.sqrt((sx - qx) ** 2 + (sy - qy) ** 2 + (sz - qz) ** 2)
         return d, d
@@ -498,17 +517,19 @@ def _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
         w = np.sqrt(ux * ux + uy * uy)
         ux /= w
         uy /= w
+        if m == first:
+            top, t_top, end0, t0, end1, t1 = first_edges
+        else:
+            top, t_top, end0, t0, end1, t1 = _panel_edges(fences, i, sx, sy, sz, qx, qy, qz)
         for edge in range(3):
             if edge == 0:  # top edge
-                length, t = _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 5],
-                                         ux, uy, 0.0, w)
+                length, t = top, t_top
                 ex, ey, ez = fences[i, 0] + t * ux, fences[i, 1] + t * uy, fences[i, 5] + nudge
             else:  # vertical end edges
                 sgn = -1.0 if edge == 1 else 1.0
                 bx = fences[i, 0] if edge == 1 else fences[i, 2]
                 by = fences[i, 1] if edge == 1 else fences[i, 3]
-                length, t = _edge_detour(sx, sy, sz, qx, qy, qz, bx, by, fences[i, 4], 0.0, 0.0, 1.0,
-                                         fences[i, 5] - fences[i, 4])
+                length, t = (end0, t0) if edge == 1 else (end1, t1)
                 ex, ey, ez = bx + sgn * nudge * ux, by + sgn * nudge * uy, fences[i, 4] + t
             if (length < best and _path_clear(fences, near, n_near, sx, sy, sz, ex, ey, ez)
                     and _path_clear(fences, near, n_near, ex, ey, ez, qx, qy, qz)):
