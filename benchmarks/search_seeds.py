@@ -1,7 +1,7 @@
 """Searchers on the flawed cells over any range of seeds (the campaign runs seeds 0..N-1 only).
 
 python benchmarks/search_seeds.py [--searchers random,mcts,mcts-commit,evolve] [--seeds 0:40] [--budget 200]
-                                  [--set NAME=JSON ...]
+                                  [--cells s1-scanner-width,...] [--set NAME=JSON ...]
 
 Each run stops at its first hazard; a failed run counts as the budget (as in the campaign). ``--set`` passes an
 option to every searcher that has it (e.g. ``--set score='"risk"'`` for evolve). Prints one Markdown row per
@@ -27,22 +27,24 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--searchers", default="random,mcts,mcts-commit,evolve")
     ap.add_argument("--seeds", default="0:40", help="first:stop")
+    ap.add_argument("--cells", default=",".join(CELLS), help="comma-separated flawed cells")
     ap.add_argument("--budget", type=int, default=200)
     ap.add_argument("--set", action="append", default=[], metavar="NAME=JSON")
     args = ap.parse_args()
     lo, hi = (int(v) for v in args.seeds.split(":"))
     opts = {k: json.loads(v) for k, v in (s.split("=", 1) for s in args.set)}
+    cells = args.cells.split(",")
     problems = {}
-    for c in CELLS:
+    for c in cells:
         sim = Simulator(c)
         problems[c] = (SimProblem(sim), Reward(criterion_for(sim.cell.spec.criterion)))
-    print("| seeds | searcher | " + " | ".join(f"{c} found | {c} mean" for c in CELLS) + " |")
-    print("|---|---|" + "---:|---:|" * len(CELLS))
+    print("| seeds | searcher | " + " | ".join(f"{c} found | {c} mean" for c in cells) + " |")
+    print("|---|---|" + "---:|---:|" * len(cells))
     for name in args.searchers.split(","):
         known = {f.name for f in fields(SEARCHERS[name])}
         mine = {k: v for k, v in opts.items() if k in known}
         cols = []
-        for c in CELLS:
+        for c in cells:
             problem, reward = problems[c]
             eps, found = [], 0
             for seed in range(lo, hi):
