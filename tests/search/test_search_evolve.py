@@ -101,11 +101,26 @@ def test_lookahead_search_on_a_cell_is_a_pure_function_of_its_seed() -> None:
     assert runs[0].risks[:6] == plain.risks[:6] and runs[0].risks != plain.risks
 
 
+def test_init_sticky_shapes_only_the_start() -> None:
+    toy = ToyWalk(secret=(1,) * 9)  # never unsafe within the horizon: every episode is kept in the top list
+    out = run_search(toy, REWARD, "evolve", 40, 0, top_k=40, until="budget", init_sticky=1.0, n_init=8)
+    start = [ep.actions for ep in out.top if ep.index <= 8]
+    later = [ep.actions for ep in out.top if ep.index > 8]
+    # (the top list keeps one entry per distinct sequence, and only 6 sequences are constant)
+    assert len(start) >= 3 and len(later) >= 20
+    assert all(len(set(a)) == 1 for a in start), start  # the start: each action repeats the first
+    assert sum(len(set(a)) > 2 for a in later) > 10  # mutations draw with sticky = 0.3
+    # None means "as sticky": the same stream as the defaults
+    assert run_search(ToyWalk(), REWARD, "evolve", 300, 3, until="budget", init_sticky=0.3) == \
+        run_search(ToyWalk(), REWARD, "evolve", 300, 3, until="budget")
+
+
 @pytest.mark.parametrize("options", [{"n_init": 0}, {"pool": 1.5}, {"keep_tail": 1.5}, {"sticky": -0.1},
                                      {"score": "distance"}, {"patience": -1}, {"n_init": True},
                                      {"score": "risk+risk"}, {"score": "risk+"}, {"score": 3}, {"focus": 1.5},
                                      {"horizon": -0.1}, {"speed": -1.0}, {"speed": float("inf")},
-                                     {"horizon": True}])
+                                     {"horizon": True}, {"init_sticky": 1.5}, {"init_sticky": "high"},
+                                     {"init_sticky": True}])
 def test_bad_options(options) -> None:
     with pytest.raises(SearchError):
         Evolve(**options)
