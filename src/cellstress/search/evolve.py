@@ -76,7 +76,7 @@ class Evolve:
     and approach ``speed`` [m/s], and the start's own repeat probability ``init_sticky`` (None: ``sticky``).
     See the module docstring."""
 
-    n_init: int = 6
+    n_init: int = 20
     pool: int = 3
     keep_tail: float = 0.5
     sticky: float = 0.3
@@ -85,7 +85,7 @@ class Evolve:
     focus: float = 0.0
     horizon: float | None = None
     speed: float = 1.6
-    init_sticky: float | None = None
+    init_sticky: float | None = 0.9
 
     name = "evolve"
 
@@ -161,7 +161,11 @@ class Evolve:
         def start() -> None:
             sticky[0] = self.sticky if self.init_sticky is None else self.init_sticky
             for _ in range(self.n_init):
-                play(tail([]))
+                for _ in range(REDRAWS):  # very sticky episodes repeat (constant sequences): play each once
+                    actions = tail([])
+                    if tuple(actions) not in played:
+                        break
+                play(actions)
             sticky[0] = self.sticky
 
         start()
