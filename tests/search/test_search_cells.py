@@ -24,8 +24,10 @@ def sims():
 
 
 # The seed of each run: 0, except where seed 0 finds nothing in 200 episodes (the recalibrated S2 is harder: the
-# paper's MCTS variants find it in 6/10 and 3/10 runs, docs/results.md); then the first seed of 0..9 that does.
-SEEDS = {("s2-elbow-intrusion", "mcts"): 2, ("s2-elbow-intrusion", "mcts-commit"): 6}
+# paper's MCTS variants find it in 6/10 and 3/10 runs, evolve in 9/10, docs/results.md); then the first seed of
+# 0..9 that does.
+SEEDS = {("s2-elbow-intrusion", "mcts"): 2, ("s2-elbow-intrusion", "mcts-commit"): 6,
+         ("s2-elbow-intrusion", "evolve"): 1}
 
 
 @pytest.mark.parametrize("cell", FLAWED)
