@@ -940,34 +940,10 @@ def step_action(P, state, action, W, out, row0):
     if state[S_UNSAFE] != 0.0:
         return 0
     spa = P.spa
-    walks = P.act[action, 0]
     h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
-    dh = P.act[action, 1]
-    df = P.act[action, 2] - f0
-    dl = P.act[action, 3] - l0
-    stride = P.body[B_WALK_SPEED] * P.scal[C_DT]
-    body, fences, floor, table_verts, table_poly = P.body, P.fences, P.floor, P.table_verts, P.table_poly
-    radius = body[B_BODY_RADIUS]
-    ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
     n = 0
     for j in range(1, spa + 1):
-        frac = j / spa
-        x, y = state[S_X], state[S_Y]
-        h, f, lt = h0 + dh * frac, f0 + df * frac, l0 + dl * frac
-        nx, ny = x, y
-        if walks != 0.0:
-            nx, ny = x + stride * np.cos(h), y + stride * np.sin(h)
-            if not feet_ok(radius, floor, table_verts, table_poly, fences, nx, ny):
-                nx, ny = x, y
-        pose_body(body, nx, ny, h, f, lt, ha, hb, hr, sh, tr)
-        if not trunk_clear(body, fences, ha, hb, hr):
-            # the new posture would put the trunk through a fence: keep the old posture where it stands
-            pose_body(body, nx, ny, state[S_HEADING], state[S_FWD], state[S_LAT], ha, hb, hr, sh, tr)
-            if trunk_clear(body, fences, ha, hb, hr):
-                h, f, lt = state[S_HEADING], state[S_FWD], state[S_LAT]
-            else:
-                nx, ny, h, f, lt = x, y, state[S_HEADING], state[S_FWD], state[S_LAT]
-        state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT] = nx, ny, h, f, lt
+        move_worker(P, state, action, h0, f0, l0, j / spa, W)
         state[S_K] += 1.0
         unsafe = sense_and_measure(P, state, W, out[row0 + n], action)
         n += 1
@@ -975,6 +951,53 @@ def step_action(P, state, action, W, out, row0):
             break
     state[S_ACTIONS] += 1.0
     return n
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def move_worker(P, state, action, h0, f0, l0, frac, W):
+    """The worker's own motion over one time step of ``action`` (begun at heading h0 and posture f0, l0):
+    ``frac`` of the action done. It depends on the actions and the fixed layout only, never on the robot."""
+    walks = P.act[action, 0]
+    body, fences, floor, table_verts, table_poly = P.body, P.fences, P.floor, P.table_verts, P.table_poly
+    ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
+    x, y = state[S_X], state[S_Y]
+    h = h0 + P.act[action, 1] * frac
+    f = f0 + (P.act[action, 2] - f0) * frac
+    lt = l0 + (P.act[action, 3] - l0) * frac
+    nx, ny = x, y
+    if walks != 0.0:
+        stride = body[B_WALK_SPEED] * P.scal[C_DT]
+        nx, ny = x + stride * np.cos(h), y + stride * np.sin(h)
+        if not feet_ok(body[B_BODY_RADIUS], floor, table_verts, table_poly, fences, nx, ny):
+            nx, ny = x, y
+    pose_body(body, nx, ny, h, f, lt, ha, hb, hr, sh, tr)
+    if not trunk_clear(body, fences, ha, hb, hr):
+        # the new posture would put the trunk through a fence: keep the old posture where it stands
+        pose_body(body, nx, ny, state[S_HEADING], state[S_FWD], state[S_LAT], ha, hb, hr, sh, tr)
+        if trunk_clear(body, fences, ha, hb, hr):
+            h, f, lt = state[S_HEADING], state[S_FWD], state[S_LAT]
+        else:
+            nx, ny, h, f, lt = x, y, state[S_HEADING], state[S_FWD], state[S_LAT]
+    state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT] = nx, ny, h, f, lt
+
+
+@njit(cache=True, error_model="numpy")
+def worker_paths(P, s0, actions, W, out):
+    """The worker's poses (x, y, heading, forward, lateral flexion) at every time step of each episode of
+    ``actions`` (n, n_actions) played from s0, as if no contact ended it: the open-loop part of the simulation
+    (``move_worker``), without robot, devices or measuring. out: (n, n_actions * spa, 5)."""
+    state = np.empty(NS)
+    spa = P.spa
+    for e in range(actions.shape[0]):
+        state[:] = s0
+        k = 0
+        for a in range(actions.shape[1]):
+            h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
+            for j in range(1, spa + 1):
+                move_worker(P, state, actions[e, a], h0, f0, l0, j / spa, W)
+                out[e, k, 0], out[e, k, 1], out[e, k, 2] = state[S_X], state[S_Y], state[S_HEADING]
+                out[e, k, 3], out[e, k, 4] = state[S_FWD], state[S_LAT]
+                k += 1
 
 
 # ---- whole episodes ---------------------------------------------------------------------------------------

@@ -253,6 +253,20 @@ class Simulator:
                 min_d[e] = rows[1:, K.M_D].min()
         return BatchResult(d_end, v_end, unsafe_step, min_d)
 
+    def worker_paths(self, actions: np.ndarray) -> np.ndarray:
+        """The worker's poses (x, y, heading [rad], forward and lateral flexion [rad]) at every 50 ms step of
+        each episode of ``actions`` (episodes, actions), as if no contact ended it: (episodes, actions * spa, 5).
+
+        The worker's motion depends on the actions and the fixed layout (walls, table, floor) only, never on
+        the robot or the devices, so this is exact and plays no episode: the rows of ``run`` hold the same poses
+        up to the step where the episode ended."""
+        acts = np.ascontiguousarray(actions, dtype=np.int64)
+        if acts.ndim != 2 or acts.size and (acts.min() < 0 or acts.max() >= N_ACTIONS):
+            raise ValueError("actions must be a 2-D array of indices in 0..29")
+        out = np.empty((acts.shape[0], acts.shape[1] * self.params.spa, 5))
+        K.worker_paths(self.params, self._s0, acts, K.make_work(self.params), out)
+        return out
+
 
 def _state_at(nxt: np.ndarray, before: np.ndarray, rows: np.ndarray, resp: np.ndarray) -> None:
     """Turn ``nxt``, the state at the end of an action played from ``before``, into the state at the step of

@@ -1,0 +1,35 @@
+"""``Simulator.worker_paths``: the worker's open-loop motion, without robot or devices, is the motion the
+simulator plays (bit for bit, up to the step where an episode ends), walls and table included."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cellstress.sim import kernels as K
+from cellstress.sim.simulator import Simulator
+
+POSE = [K.M_X, K.M_Y, K.M_HEADING, K.M_FWD, K.M_LAT]
+
+
+@pytest.mark.parametrize("cell", ["baseline", "s2-elbow-intrusion", "s3-fence-gap"])
+def test_paths_are_the_simulated_poses(cell) -> None:
+    sim = Simulator(cell)
+    rng = np.random.default_rng(4)
+    acts = rng.integers(0, sim.n_actions, size=(300, sim.actions_per_episode))
+    acts[:100] = rng.integers(0, 6, size=(100, sim.actions_per_episode))  # straight walks: into walls and table
+    paths = sim.worker_paths(acts)
+    assert paths.shape == (300, sim.actions_per_episode * sim.steps_per_action, 5)
+    blocked = 0
+    for e in range(len(acts)):
+        rows = sim.run(acts[e]).rows[1:]  # (the first row is s0)
+        assert np.array_equal(paths[e, : len(rows)], rows[:, POSE]), e
+        walked = np.hypot(*np.diff(paths[e, :, :2], axis=0).T)
+        blocked += int(np.sum((acts[e].repeat(sim.steps_per_action)[1:] < 6) & (walked == 0.0)))
+    assert blocked > 0  # some walks ran into a wall, the table or a fence and were stopped there
+
+
+def test_bad_actions_are_refused() -> None:
+    sim = Simulator("baseline")
+    with pytest.raises(ValueError):
+        sim.worker_paths(np.array([[0, 30]]))
