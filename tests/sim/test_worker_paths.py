@@ -33,3 +33,24 @@ def test_bad_actions_are_refused() -> None:
     sim = Simulator("baseline")
     with pytest.raises(ValueError):
         sim.worker_paths(np.array([[0, 30]]))
+
+
+@pytest.mark.parametrize("cell", ["s2-elbow-intrusion", "s3-fence-gap"])
+def test_distance_to_the_robot_point_of_a_row_is_its_d_hr(cell) -> None:
+    """The robot point a row names lies on the robot, so the worker is at least d_HR from it; and it is the
+    closest point, so not much more (the reach volumes are met at the capsule axis, then moved to its surface)."""
+    sim = Simulator(cell)
+    acts = np.random.default_rng(9).integers(0, sim.n_actions, size=(60, sim.actions_per_episode))
+    rows = np.concatenate([sim.run(a).rows[1:] for a in acts])
+    # within reach, and not touching (a row reports a penetration as d_HR = 0)
+    rows = rows[(rows[:, K.M_D] < 0.8) & (rows[:, K.M_D] > 0.0)]
+    points = rows[:, None, [K.M_RX, K.M_RY, K.M_RZ]]
+    dist = sim.worker_distances(rows[:, POSE], points)[:, 0]
+    d = rows[:, K.M_D]
+    gap = dist - d
+    assert len(rows) > 300
+    # d_HR itself may be long by the reach trace's tolerance far from contact: one 2 cm grid step plus 5 %
+    assert np.all(gap > -(0.02 + 0.05 * d)), gap.min()
+    assert np.median(gap) < 0.01 and np.quantile(gap, 0.95) < 0.05, np.quantile(gap, [0.5, 0.95])
+    far = sim.worker_distances(rows[:3, POSE], np.full((3, 2, 3), np.nan))
+    assert np.all(far == np.inf)

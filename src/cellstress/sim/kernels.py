@@ -1000,6 +1000,32 @@ def worker_paths(P, s0, actions, W, out):
                 k += 1
 
 
+@njit(cache=True, error_model="numpy")
+def worker_point_distances(P, W, poses, points, out):
+    """out[i, j]: distance from the worker at poses[i] (x, y, heading, forward, lateral flexion) to the point
+    points[i, j], as ``separation`` measures the worker's side of d_HR: the nearer of the two reach volumes
+    (fences respected) and the body capsules; inf for a NaN point. The robot plays no part."""
+    arm, origin, grid_h = P.body[B_ARM_LEN], P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H]
+    ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
+    for i in range(poses.shape[0]):
+        pose_body(P.body, poses[i, 0], poses[i, 1], poses[i, 2], poses[i, 3], poses[i, 4], ha, hb, hr, sh, tr)
+        n_near = collect_near_fences(P.fences, sh, W.near, arm + 0.05)
+        for j in range(points.shape[1]):
+            px, py, pz = points[i, j, 0], points[i, j, 1], points[i, j, 2]
+            if np.isnan(px):
+                out[i, j] = np.inf
+                continue
+            best = np.inf
+            for side in range(2):
+                best = min(best, _reach_value(P.reach, origin, grid_h, arm, P.fences, W.near, sh, tr, side, n_near,
+                                              px, py, pz))
+            for c in range(N_BODY_CAPSULES):
+                d2 = segment_segment_xyz(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2],
+                                         px, py, pz, px, py, pz)[0]
+                best = min(best, np.sqrt(d2) - hr[c])
+            out[i, j] = best
+
+
 # ---- whole episodes ---------------------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
 def run_episode(P, s0, actions, out):

@@ -267,6 +267,18 @@ class Simulator:
         K.worker_paths(self.params, self._s0, acts, K.make_work(self.params), out)
         return out
 
+    def worker_distances(self, poses: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """Distance from the worker at each of ``poses`` (n, 5: x, y, heading, forward and lateral flexion, as in
+        the metric rows) to each of its ``points`` (n, m, 3; NaN rows are skipped and give inf): the worker's
+        side of d_HR (reach volumes around the walls, body capsules), without the robot. (n, m)."""
+        poses = np.ascontiguousarray(poses, dtype=np.float64)
+        points = np.ascontiguousarray(points, dtype=np.float64)
+        if poses.ndim != 2 or poses.shape[1] != 5 or points.ndim != 3 or points.shape[::2] != (len(poses), 3):
+            raise ValueError("poses must be (n, 5) and points (n, m, 3)")
+        out = np.empty(points.shape[:2])
+        K.worker_point_distances(self.params, K.make_work(self.params), poses, points, out)
+        return out
+
 
 def _state_at(nxt: np.ndarray, before: np.ndarray, rows: np.ndarray, resp: np.ndarray) -> None:
     """Turn ``nxt``, the state at the end of an action played from ``before``, into the state at the step of
