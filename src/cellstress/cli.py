@@ -289,8 +289,9 @@ def search(
     cell: Annotated[str, typer.Argument(help=CELL_HELP)],
     out: Annotated[str, typer.Option("--out", "-o", help="Folder for result.json (created if needed).")],
     searcher: Annotated[str, typer.Option("--searcher", "-s", help="random, mcts (MCTS1: from s0 for the "
-                                          "whole budget), mcts-commit (MCTS2: commit and re-root) or evolve "
-                                          "(ours: mutates the best episodes).")] = "mcts",
+                                          "whole budget), mcts-commit (MCTS2: commit and re-root), evolve "
+                                          "(ours: mutates the best episodes) or plan (ours: learns the robot "
+                                          "and devices from the episodes, plans the worker).")] = "mcts",
     budget: Annotated[int, typer.Option("--budget", "-b", help="Episodes (one iteration = one episode of "
                                         "up to 8 actions from s0).")] = 200,
     seed: Annotated[int, typer.Option("--seed", help="Seed (>= 0) of numpy's SeedSequence.")] = 0,

@@ -1,4 +1,5 @@
-"""Search for hazards: ``random``, ``mcts`` (the paper's MCTS1), ``mcts-commit`` (MCTS2) and ``evolve`` (ours).
+"""Search for hazards: ``random``, ``mcts`` (the paper's MCTS1), ``mcts-commit`` (MCTS2), and ours: ``evolve``
+and ``plan``.
 
 One module per searcher over shared machinery (``common``: problem interface, reward, budget, top-k;
 ``tree``: the DPW tree; ``result``: the result record). ``search`` is the public entry point.
@@ -25,17 +26,18 @@ from cellstress.search.common import (
 from cellstress.search.evolve import Evolve
 from cellstress.search.mcts import MCTS
 from cellstress.search.mcts_commit import MCTSCommit
+from cellstress.search.plan import Plan
 from cellstress.search.random_search import RandomSearch
 from cellstress.search.result import SearchResult
 from cellstress.search.slices import SLICED
 
-SEARCHERS = {"random": RandomSearch, "mcts": MCTS, "mcts-commit": MCTSCommit, "evolve": Evolve}
+SEARCHERS = {"random": RandomSearch, "mcts": MCTS, "mcts-commit": MCTSCommit, "evolve": Evolve, "plan": Plan}
 DEFAULT_BUDGET = 200
 DEFAULT_TOP_K = 10
 
-__all__ = ["SEARCHERS", "UNTIL", "Episode", "Evolve", "MCTS", "MCTSCommit", "Outcome", "Problem", "RandomSearch",
-           "Recorder", "Reward", "SearchError", "SearchResult", "SimProblem", "make_searcher", "parse_options",
-           "run_search", "search"]
+__all__ = ["SEARCHERS", "UNTIL", "Episode", "Evolve", "MCTS", "MCTSCommit", "Outcome", "Plan", "Problem",
+           "RandomSearch", "Recorder", "Reward", "SearchError", "SearchResult", "SimProblem", "make_searcher",
+           "parse_options", "run_search", "search"]
 
 
 def parse_options(settings: list[str] | tuple[str, ...] | None, flag: str = "--set") -> dict:
