@@ -40,7 +40,7 @@ def test_finds_every_hazard_in_few_episodes(sims, cell) -> None:
         ep = out.first_hazard
         assert sim.run(list(ep.actions)).unsafe  # the hazard replays from s0 by its actions alone
         episodes.append(ep.index)
-    # measured on seeds 0-4: 5.0 / 12.0 / 5.6 on average (random search: about 180 / 170 / 90, docs/results.md)
+    # measured on seeds 0-4: 3.2 / 15.6 / 3.0 on average (random search: about 180 / 170 / 90, docs/results.md)
     assert np.mean(episodes) < 30, episodes
 
 
