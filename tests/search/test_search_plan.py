@@ -44,6 +44,13 @@ def test_finds_every_hazard_in_few_episodes(sims, cell) -> None:
     assert np.mean(episodes) < 30, episodes
 
 
+@pytest.mark.parametrize("budget", [1, 2, 3, 17])
+def test_budget_is_exact(budget) -> None:
+    sim = Simulator("baseline")  # safe: the whole budget is used
+    out = run_search(SimProblem(sim), Reward(sim.criterion), "plan", budget, 0)
+    assert out.episodes == budget and len(out.risks) == budget and not out.found
+
+
 def test_same_seed_same_search(sims) -> None:
     sim = sims["s2-elbow-intrusion"]
     reward = Reward(sim.criterion)
