@@ -165,7 +165,8 @@ class _Model:
         self.points: list[dict] = [{} for _ in range(self.n_steps + 1)]  # step -> {cell: (point, offset)}
         self.speed = np.full(self.n_steps + 1, np.nan)  # v_R on the programmed path, per step (1-based)
         self.delays: dict[int, list[tuple[int, int]]] = {}  # device mask -> [(to braking, to standstill)]
-        self.prefix_rows: dict[tuple[int, ...], np.ndarray] = {}
+        # played prefix -> (its rows' count, devices seen per row, first braking and standstill row or -1)
+        self.prefixes: dict[tuple[int, ...], tuple[int, np.ndarray, int, int]] = {}
         self.feats: list[np.ndarray] = []
         self.seen: list[np.ndarray] = []
         self._tree = self._by_step = None
@@ -177,8 +178,14 @@ class _Model:
 
     def learn(self, actions: list[int], rows: np.ndarray) -> None:
         K = self.K
+        seen = rows[:, K.M_SEEN].astype(np.int64)
+        braking = np.flatnonzero(rows[:, K.M_PHASE] >= K.PHASE_BRAKING)
+        stopped = np.flatnonzero(rows[:, K.M_PHASE] >= K.PHASE_STOPPED)
         for p in range(1, len(actions) + 1):
-            self.prefix_rows[tuple(actions[:p])] = rows[: p * self.spa]
+            n = min(p * self.spa, len(rows))
+            b = int(braking[0]) if len(braking) and braking[0] < n else -1
+            s = int(stopped[0]) if len(stopped) and stopped[0] < n else -1
+            self.prefixes[tuple(actions[:p])] = (n, seen[:n], b, s)
         on_path = rows[rows[:, K.M_PHASE] <= K.PHASE_PENDING]
         if len(on_path):
             pts = on_path[:, [K.M_RX, K.M_RY, K.M_RZ]]
@@ -191,24 +198,14 @@ class _Model:
                 old = self.points[k].get(cell)
                 if old is None or offset < old[1]:
                     self.points[k][cell] = (point, offset)
-        seen = rows[:, K.M_SEEN].astype(np.int64)
         if seen.any():
             first = int(np.argmax(seen > 0))
-            braking = np.flatnonzero(rows[:, K.M_PHASE] >= K.PHASE_BRAKING)
-            stopped = np.flatnonzero(rows[:, K.M_PHASE] >= K.PHASE_STOPPED)
             if len(stopped):
                 self.delays.setdefault(int(seen[first]), []).append((int(braking[0]) - first,
                                                                       int(stopped[0]) - first))
         self.feats.append(self._features(rows[:, self.pose_cols]))
         self.seen.append(seen)
         self._tree = self._by_step = None
-
-    def _stop_steps(self, mask: int, first: int) -> tuple[int, int]:
-        """(braking, standstill) step indices after a first detection at ``first`` by the devices ``mask``."""
-        seen = self.delays.get(mask)
-        if not seen:
-            return self.n_steps, self.n_steps
-        return first + int(np.median([b for b, _ in seen])), first + int(np.median([s for _, s in seen]))
 
     def _step_points(self) -> tuple[np.ndarray, np.ndarray]:
         """The robot points and offsets of every step, padded with NaN points: (steps + 1, m, 3), (steps + 1, m)."""
@@ -226,7 +223,6 @@ class _Model:
         """The predicted clearance of each sequence (module docstring, 3.)."""
         from scipy.spatial import cKDTree
 
-        K = self.K
         n, steps = len(seqs), self.n_steps
         if self._tree is None:
             self._tree = (cKDTree(np.concatenate(self.feats)), np.concatenate(self.seen))
@@ -234,24 +230,30 @@ class _Model:
         poses = self.sim.worker_paths(seqs).reshape(-1, 5)
         seen = seen_at[tree.query(self._features(poses))[1]].reshape(n, steps)
         known = np.zeros(n, dtype=np.int64)
-        brake = np.full(n, steps)
-        stop = np.full(n, steps)
+        played_brake = np.full(n, -1)
+        played_stop = np.full(n, -1)
         for i, seq in enumerate(map(tuple, seqs.tolist())):
             p = len(seq) - 1
-            while p > 0 and seq[:p] not in self.prefix_rows:
+            while p > 0 and seq[:p] not in self.prefixes:
                 p -= 1
-            rows = self.prefix_rows.get(seq[:p]) if p else None
-            if rows is not None:
-                known[i] = len(rows)
-                seen[i, : len(rows)] = rows[:, K.M_SEEN]
-            detected = np.flatnonzero(seen[i])
-            if len(detected):
-                brake[i], stop[i] = self._stop_steps(int(seen[i, detected[0]]), int(detected[0]))
-            if rows is not None:  # the stop as it happened, where the played prefix shows it
-                b = np.flatnonzero(rows[:, K.M_PHASE] >= K.PHASE_BRAKING)
-                s = np.flatnonzero(rows[:, K.M_PHASE] >= K.PHASE_STOPPED)
-                brake[i] = b[0] if len(b) else brake[i]
-                stop[i] = s[0] if len(s) else stop[i]
+            if p:
+                known[i], seen_k, played_brake[i], played_stop[i] = self.prefixes[seq[:p]]
+                seen[i, : known[i]] = seen_k
+        # the stop after the first detection, by the delays learned for the devices that saw the worker first
+        # (unknown devices: the robot is taken to keep moving); where the played prefix shows it, as it happened
+        brake = np.full(n, steps)
+        stop = np.full(n, steps)
+        detected = seen.any(axis=1)
+        first = (seen > 0).argmax(axis=1)
+        mask = seen[np.arange(n), first]
+        for m in np.unique(mask[detected]):
+            delays = self.delays.get(int(m))
+            if delays:
+                sel = detected & (mask == m)
+                brake[sel] = first[sel] + int(np.median([b for b, _ in delays]))
+                stop[sel] = first[sel] + int(np.median([s for _, s in delays]))
+        brake = np.where(played_brake >= 0, played_brake, brake)
+        stop = np.where(played_stop >= 0, played_stop, stop)
         # the robot step each candidate step meets (0-based step k -> row step k + 1; braking: its first step)
         k = np.arange(steps)[None, :]
         robot_step = np.minimum(k, brake[:, None]) + 1
