@@ -51,6 +51,15 @@ def test_budget_is_exact(budget) -> None:
     assert out.episodes == budget and len(out.risks) == budget and not out.found
 
 
+def test_until_budget_never_replays_a_hazard(sims) -> None:
+    # a candidate that begins with a sequence cut short by a hazard would replay that episode: never drawn
+    sim = sims["s3-fence-gap"]
+    out = run_search(SimProblem(sim), Reward(sim.criterion), "plan", 60, 1, until="budget")
+    actions = [h.actions for h in out.hazards]
+    assert len(actions) > 30 and len(set(actions)) == len(actions)  # measured: 57 hazards, all distinct
+    assert not any(a[: len(b)] == b for a in actions for b in actions if len(b) < len(a))
+
+
 def test_same_seed_same_search(sims) -> None:
     sim = sims["s2-elbow-intrusion"]
     reward = Reward(sim.criterion)

@@ -96,6 +96,10 @@ class Plan:
         horizon, n_actions = problem.actions_per_episode, problem.n_actions
         model = _Model(problem.sim)
         closest: dict[tuple[int, ...], float] = {}  # played sequence -> its least d_HR before any device reacted
+        ended: set[tuple[int, ...]] = set()  # played sequences cut short by a hazard (with until="budget")
+
+        def replays(seq: tuple[int, ...]) -> bool:
+            return seq in closest or any(seq[:p] in ended for p in range(1, len(seq)))
 
         def sticky_tail(actions: list[int], repeat: float) -> list[int]:
             while len(actions) < horizon:
@@ -116,6 +120,8 @@ class Plan:
                     break
             rows = np.concatenate(rows)
             model.learn(played, rows)
+            if len(played) < len(actions):
+                ended.add(tuple(played))
             running = rows[rows[:, K.M_PHASE] == K.PHASE_RUNNING, K.M_D]
             closest[tuple(played)] = float(running.min()) if len(running) else math.inf
             rec.finish(played, ret, risk, unsafe)  # raises Stop at the end
@@ -139,7 +145,7 @@ class Plan:
                     if rng.random() < self.keep_tail:
                         child += parent[j + 1:]
                     child = sticky_tail(child, self.sticky)
-                if tuple(child) not in closest:
+                if not replays(tuple(child)):
                     cands.add(tuple(child))
                     if len(cands) >= self.candidates:
                         break
