@@ -24,7 +24,7 @@ FLAW = {"front-scanner": "scanner", "bay-curtain": "curtain", "none": "none"}
 FLAW_START = {("start:upper-end", "front-scanner"): "S1", ("start:lower-end", "bay-curtain"): "S2",
               ("start:lower-end-right", "none"): "S3"}
 RUNS = {"random": ("random", False), "mcts": ("mcts", False), "mcts --distinct": ("mcts", True),
-        "evolve": ("evolve", False), "evolve --distinct": ("evolve", True)}
+        "evolve": ("evolve", False), "evolve --distinct": ("evolve", True), "plan --distinct": ("plan", True)}
 
 
 def classes_of(sim, res):

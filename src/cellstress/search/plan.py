@@ -37,10 +37,14 @@ simulator as a black box; ``plan`` separates what the searcher controls from wha
    from 2 until the budget is used up or the first hazard is found.
 
 Every episode is one action sequence played from s0 and counted, as for the other searchers; what the model
-computes plays no episode. It needs a cell's simulator (``SimProblem``) with one start point; on ``all-flaws``
-use ``evolve --distinct``. Defaults (``n_init`` = 2, ``init_sticky`` = 0.9, ``candidates`` = 200, ``explore`` =
-0.3, ``sticky`` = 0.3, ``pool`` = 5, ``keep_tail`` = 0.5) were chosen on the three flawed cells, seeds 0-39,
-budget 200; docs/results.md gives the numbers and the settings tried.
+computes plays no episode. It needs a cell's simulator (``SimProblem``) with one start point; on a cell with
+several (``all-flaws``) it runs with ``--distinct``, whose slices give each start point its own searches
+(``search.slices``). It does not use the slices' ``known_hazard`` hook: a class already found is not steered
+away from, so most of a ``--until budget`` run's episodes rediscover known classes.
+
+Defaults (``n_init`` = 2, ``init_sticky`` = 0.9, ``candidates`` = 200, ``explore`` = 0.3, ``sticky`` = 0.3,
+``pool`` = 5, ``keep_tail`` = 0.5) were chosen on the three flawed cells, seeds 0-39, budget 200;
+docs/results.md gives the numbers and the settings tried.
 
 Randomness: one numpy Generator from ``SeedSequence(seed, spawn_key=(9,))``.
 """
@@ -88,8 +92,8 @@ class Plan:
 
     def run(self, problem, reward, rec: Recorder, seed: int) -> None:
         if not isinstance(problem, SimProblem) or not hasattr(problem.sim, "worker_paths"):
-            raise SearchError("plan searches a cell's simulator with one start point (for a cell with several, "
-                              "use evolve with --distinct)")
+            raise SearchError("plan searches a cell's simulator from one start point (for a cell with several, "
+                              "add --distinct: each start point then gets its own searches)")
         from cellstress.sim import kernels as K
 
         rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(PLAN_KEY,)))

@@ -39,7 +39,7 @@ from cellstress.search.common import Outcome, Recorder, SimProblem, Stop
 
 SLICE_KEY = 7
 SLICE_LEN = 200  # evolve finds S2, the hardest single flaw, within 200 episodes in 166 of 200 seeds (results.md)
-SLICED = ("evolve",)  # searchers that play whole episodes and take a fresh problem per slice
+SLICED = ("evolve", "plan")  # searchers that play whole episodes and take a fresh problem per slice
 
 
 class SliceOver(Exception):  # noqa: N818 (a signal, like Stop)
