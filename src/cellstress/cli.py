@@ -314,8 +314,8 @@ def search(
                                                   "iso15066 (force limits per body region); default: the "
                                                   "cell file's.")] = None,
     distinct: Annotated[bool, typer.Option("--distinct", help="With --until budget: cluster the hazards "
-                                           "into classes, steer away from classes found, list each (evolve: "
-                                           "the budget shared between the start points in slices).")] = False,
+                                           "into classes, steer away from classes found, list each (evolve, "
+                                           "plan: the budget shared between the start points in slices).")] = False,
     settings: Annotated[list[str] | None, typer.Option("--set", help="Any other option of the searcher, "
                                                        "NAME=VALUE, repeated (e.g. --set pool=5 --set "
                                                        "score=risk for evolve; its docstring lists them).")] = None,

@@ -90,14 +90,14 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
            top_k: int = DEFAULT_TOP_K, progress=None, distinct: bool = False, **options) -> SearchResult:
     """Search a cell (built-in name, path, ``Cell`` or ``Simulator``) for an unsafe action sequence.
 
-    ``searcher`` is ``random``, ``mcts``, ``mcts-commit`` or ``evolve``; ``options`` are its parameters (see
-    ``MCTS``, ``MCTSCommit``, ``RandomSearch``, ``Evolve``). ``until="first"`` stops at the first hazard,
+    ``searcher`` is ``random``, ``mcts``, ``mcts-commit``, ``evolve`` or ``plan``; ``options`` are its parameters
+    (see ``MCTS``, ``MCTSCommit``, ``RandomSearch``, ``Evolve``, ``Plan``). ``until="first"`` stops at the first hazard,
     ``until="budget"`` plays the whole budget. ``progress(episodes, best_risk)`` is called after each episode.
     ``distinct=True`` (with ``until="budget"``) clusters the hazards into classes and steers the search away
     from classes already found (``search.distinct``); the result lists each class's first hazard. A cell with
     several start points (``human.starts``) lets each episode's first decision pick one (``search.multistart``);
-    with ``evolve`` the distinct mode instead shares the budget between the start points in slices
-    (``search.slices``).
+    with ``evolve`` and ``plan`` the distinct mode instead shares the budget between the start points in slices
+    (``search.slices``; ``plan`` needs it on such a cell).
     """
     from cellstress import __version__
     from cellstress.human.actions import ACTION_NAMES

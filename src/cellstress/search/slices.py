@@ -1,5 +1,6 @@
-"""Distinct mode for whole-episode searchers (``evolve --until budget --distinct``): the budget shared between
-the start points in slices, a fresh search in each slice, hazards of known classes worthless.
+"""Distinct mode for whole-episode searchers (``evolve`` or ``plan`` with ``--until budget --distinct``): the
+budget shared between the start points in slices, a fresh search in each slice, hazards of known classes worthless
+(to ``evolve``, which has the hook).
 
 Why not one search over all start points: a searcher that picks the start with the first decision (``mcts``
 over ``MultiStartProblem``) commits to the start point whose episodes first pay and rarely returns to the others
