@@ -57,6 +57,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cellstress.search.common import Recorder, SearchError, SimProblem
+from cellstress.search.evolve import REDRAWS
 
 PLAN_KEY = 9
 POINT_GRID = 0.02  # robot points closer than this (per coordinate, rounded) are kept as one, with the least offset
@@ -99,11 +100,12 @@ class Plan:
         rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(PLAN_KEY,)))
         horizon, n_actions = problem.actions_per_episode, problem.n_actions
         model = _Model(problem.sim)
-        closest: dict[tuple[int, ...], float] = {}  # played sequence -> its least d_HR before any device reacted
-        ended: set[tuple[int, ...]] = set()  # played sequences cut short by a hazard (with until="budget")
+        # played sequence -> its least d_HR before any device reacted; a key shorter than the horizon is an
+        # episode cut short by a hazard (with until="budget"), which any sequence beginning with it would replay
+        closest: dict[tuple[int, ...], float] = {}
 
         def replays(seq: tuple[int, ...]) -> bool:
-            return seq in closest or any(seq[:p] in ended for p in range(1, len(seq)))
+            return any(seq[:p] in closest for p in range(1, len(seq) + 1))
 
         def sticky_tail(actions: list[int], repeat: float) -> list[int]:
             while len(actions) < horizon:
@@ -124,16 +126,14 @@ class Plan:
                     break
             rows = np.concatenate(rows)
             model.learn(played, rows)
-            if len(played) < len(actions):
-                ended.add(tuple(played))
             running = rows[rows[:, K.M_PHASE] == K.PHASE_RUNNING, K.M_D]
             closest[tuple(played)] = float(running.min()) if len(running) else math.inf
             rec.finish(played, ret, risk, unsafe)  # raises Stop at the end
 
         for _ in range(self.n_init):
-            for _ in range(50):  # very sticky episodes are often constant sequences: play each once
+            for _ in range(REDRAWS):  # very sticky episodes are often constant sequences: play each once
                 actions = sticky_tail([], self.init_sticky)
-                if tuple(actions) not in closest:
+                if not replays(tuple(actions)):
                     break
             play(actions)
         while True:

@@ -114,6 +114,7 @@ class Simulator:
         self._s0.setflags(write=False)
         self._rows = np.zeros((self.params.spa, K.NM))
         self.forces = _force_model(self.layout)
+        self._worker_w = None
 
     @property
     def criterion(self):
@@ -228,9 +229,7 @@ class Simulator:
 
     def run_batch(self, actions: np.ndarray) -> BatchResult:
         """Many episodes at once on all cores; ``actions`` is (episodes, actions) of action indices."""
-        acts = np.ascontiguousarray(actions, dtype=np.int64)
-        if acts.ndim != 2 or acts.size and (acts.min() < 0 or acts.max() >= N_ACTIONS):
-            raise ValueError("actions must be a 2-D array of indices in 0..29")
+        acts = _action_array(actions)
         n_ep, n_act = acts.shape
         d_end = np.empty((n_ep, n_act))
         v_end = np.empty((n_ep, n_act))
@@ -260,11 +259,9 @@ class Simulator:
         The worker's motion depends on the actions and the fixed layout (walls, table, floor) only, never on
         the robot or the devices, so this is exact and plays no episode: the rows of ``run`` hold the same poses
         up to the step where the episode ended."""
-        acts = np.ascontiguousarray(actions, dtype=np.int64)
-        if acts.ndim != 2 or acts.size and (acts.min() < 0 or acts.max() >= N_ACTIONS):
-            raise ValueError("actions must be a 2-D array of indices in 0..29")
+        acts = _action_array(actions)
         out = np.empty((acts.shape[0], acts.shape[1] * self.params.spa, 5))
-        K.worker_paths(self.params, self._s0, acts, K.make_work(self.params), out)
+        K.worker_paths(self.params, self._s0, acts, self._worker_work(), out)
         return out
 
     def worker_distances(self, poses: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -276,8 +273,23 @@ class Simulator:
         if poses.ndim != 2 or poses.shape[1] != 5 or points.ndim != 3 or points.shape[::2] != (len(poses), 3):
             raise ValueError("poses must be (n, 5) and points (n, m, 3)")
         out = np.empty(points.shape[:2])
-        K.worker_point_distances(self.params, K.make_work(self.params), poses, points, out)
+        K.worker_point_distances(self.params, self._worker_work(), poses, points, out)
         return out
+
+    def _worker_work(self):
+        """Work arrays of the worker-only kernels, made once: separate from the stepping ones, which keep the
+        robot's standstill pose between calls."""
+        if self._worker_w is None:
+            self._worker_w = K.make_work(self.params)
+        return self._worker_w
+
+
+def _action_array(actions) -> np.ndarray:
+    """``actions`` as a contiguous (episodes, actions) int64 array; ValueError for anything else."""
+    acts = np.ascontiguousarray(actions, dtype=np.int64)
+    if acts.ndim != 2 or acts.size and (acts.min() < 0 or acts.max() >= N_ACTIONS):
+        raise ValueError(f"actions must be a 2-D array of indices in 0..{N_ACTIONS - 1}")
+    return acts
 
 
 def _state_at(nxt: np.ndarray, before: np.ndarray, rows: np.ndarray, resp: np.ndarray) -> None:
