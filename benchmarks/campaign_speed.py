@@ -82,7 +82,7 @@ def startup_profile(threads: int) -> list[tuple[str, float]]:
 
     set_threads(threads)
     from cellstress.cell.load import load_cell
-    from cellstress.search import search
+    from cellstress.searchers import search
     from cellstress.sim.build import build_layout
     from cellstress.sim.simulator import Simulator
 

@@ -14,8 +14,8 @@ from __future__ import annotations
 import sys
 import time
 
-from cellstress.search import search
-from cellstress.search.distinct import hazard_class
+from cellstress.searchers import search
+from cellstress.searchers.distinct import hazard_class
 from cellstress.sim.simulator import Simulator
 
 FLAW = {"front-scanner": "scanner", "bay-curtain": "curtain", "none": "none"}
@@ -29,7 +29,7 @@ RUNS = {"random": ("random", False), "mcts": ("mcts", False), "mcts --distinct":
 
 def classes_of(sim, res):
     """[(episode, start name, class key)] of a result's hazards, each class once, in the order found."""
-    from cellstress.search.multistart import split_start
+    from cellstress.searchers.multistart import split_start
 
     if res.distinct is not None:
         return [(d["episode"], d["actions"][0], (d["class"]["device"], d["class"]["robot_link"],

@@ -16,8 +16,8 @@ import statistics
 from dataclasses import fields
 
 from cellstress.criteria import criterion_for
-from cellstress.search import SEARCHERS, make_searcher, run_search
-from cellstress.search.common import Reward, SimProblem
+from cellstress.searchers import SEARCHERS, make_searcher, run_search
+from cellstress.searchers.common import Reward, SimProblem
 from cellstress.sim.simulator import Simulator
 
 CELLS = ("s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap")

@@ -37,7 +37,7 @@ def main(argv=None) -> None:
 
     if args.threads:
         numba.set_num_threads(args.threads)
-    from cellstress.search import SEARCHERS, search
+    from cellstress.searchers import SEARCHERS, search
     from cellstress.sim.simulator import Simulator
 
     rows = []

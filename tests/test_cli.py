@@ -158,7 +158,7 @@ def test_check_without_iso13855_module(capsys, monkeypatch) -> None:
 
 
 def test_check_iso13855_user_error_is_one_line(capsys, monkeypatch) -> None:
-    from cellstress.errors import CellError
+    from cellstress.core.errors import CellError
 
     def static_check(cell):
         raise CellError(cell.source, "devices[0]", "too close")

@@ -1,22 +1,32 @@
-"""cellstress: find hidden human-robot hazards in robot cells by Adaptive Stress Testing."""
+"""cellstress: find hidden human-robot hazards in robot cells by Adaptive Stress Testing.
+
+The Python API is ``cellstress.api`` (``load_cell``, ``parse_cell``, ``check``, ``search``, ``simulate``,
+``write_report``), also reachable here; ``Simulator`` is the cell simulator. They are imported on first use:
+the simulator pulls in numba, and the command line should start fast.
+"""
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-__version__ = "0.3.0"
+from cellstress.core.version import __version__
 
-__all__ = ["BUILTIN_CELLS", "Cell", "Simulator", "__version__", "load_cell", "search"]
+__all__ = ["BUILTIN_CELLS", "Cell", "Simulator", "__version__", "check", "load_cell", "parse_cell", "search",
+           "simulate", "write_report"]
+_API = ("check", "load_cell", "parse_cell", "search", "simulate", "write_report")
 
 if TYPE_CHECKING:
-    from cellstress.cell.load import BUILTIN_CELLS, Cell, load_cell
-    from cellstress.search import search
+    from cellstress.api import check, load_cell, parse_cell, search, simulate, write_report
+    from cellstress.cell.load import BUILTIN_CELLS, Cell
     from cellstress.sim.simulator import Simulator
 
 
 def __getattr__(name: str):
-    # Imported on first use: the simulator pulls in numba, and the command line should start fast.
-    if name in ("BUILTIN_CELLS", "Cell", "load_cell"):
+    if name in _API:
+        from cellstress import api
+
+        return getattr(api, name)
+    if name in ("BUILTIN_CELLS", "Cell"):
         from cellstress.cell import load
 
         return getattr(load, name)
@@ -24,9 +34,4 @@ def __getattr__(name: str):
         from cellstress.sim.simulator import Simulator
 
         return Simulator
-    if name == "search":
-        # the subpackage cellstress.search is callable: cellstress.search(cell, searcher=..., budget=..., seed=...)
-        import importlib
-
-        return importlib.import_module("cellstress.search")
     raise AttributeError(f"module 'cellstress' has no attribute {name!r}")

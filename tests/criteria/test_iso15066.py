@@ -9,6 +9,7 @@ import pinocchio as pin
 import pytest
 
 from cellstress.cell.load import load_cell
+from cellstress.core.errors import CellstressError
 from cellstress.criteria import ContactWhileMoving, criterion_for, with_criterion
 from cellstress.criteria.iso15066 import (
     REGIONS,
@@ -21,7 +22,6 @@ from cellstress.criteria.iso15066 import (
     region_force,
     transient_limit,
 )
-from cellstress.errors import CellstressError
 from cellstress.human.actions import action_index
 from cellstress.sim import kernels as K
 from cellstress.sim.determinism import check_determinism

@@ -61,7 +61,7 @@ def test_contact_marker_is_at_the_contact(s3_report, s3_sim):
     plot's own data-to-pixel transform."""
     from cellstress.report.episode import episode_of
     from cellstress.report.hazard import topview_figure
-    from cellstress.search.result import SearchResult
+    from cellstress.searchers.result import SearchResult
 
     res = SearchResult.load(s3_report / "result.json")
     view = episode_of(res, s3_sim)
@@ -87,7 +87,7 @@ def test_contact_marker_is_at_the_contact(s3_report, s3_sim):
 def test_contact_point_lies_on_the_drawn_robot_link(s3_report, s3_sim):
     """The robot drawn at the contact step (from sim.scene) carries the contact point on its named link."""
     from cellstress.report.episode import episode_of
-    from cellstress.search.result import SearchResult
+    from cellstress.searchers.result import SearchResult
 
     res = SearchResult.load(s3_report / "result.json")
     view = episode_of(res, s3_sim)

@@ -93,7 +93,7 @@ def test_lookahead_leaves_the_simulator_alone() -> None:
 
 
 def test_problem_and_simulator_expose_it() -> None:
-    from cellstress.search.common import SimProblem
+    from cellstress.searchers.common import SimProblem
 
     sim = Simulator("s2-elbow-intrusion")
     state, rows = sim.step(sim.reset(), action_index("walk+upright"))

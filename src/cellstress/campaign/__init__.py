@@ -17,18 +17,18 @@ from cellstress.campaign.backends import BACKENDS, Backend
 from cellstress.campaign.plan import (
     DEFAULT_BUDGET,
     DEFAULT_CELLS,
-    DEFAULT_SEARCHERS,
     DEFAULT_SEEDS,
     CampaignError,
     CampaignPlan,
+    paper_searchers,
     resolve,
 )
 
 if TYPE_CHECKING:  # table imports scipy: only when a table is written
     from cellstress.campaign.table import Row
 
-__all__ = ["BACKENDS", "DEFAULT_BUDGET", "DEFAULT_CELLS", "DEFAULT_SEARCHERS", "DEFAULT_SEEDS", "Backend",
-           "CampaignError", "CampaignPlan", "Outcome", "resolve", "run_campaign"]
+__all__ = ["BACKENDS", "DEFAULT_BUDGET", "DEFAULT_CELLS", "DEFAULT_SEEDS", "Backend",
+           "CampaignError", "CampaignPlan", "Outcome", "paper_searchers", "resolve", "run_campaign"]
 
 
 @dataclass(frozen=True)
@@ -53,8 +53,7 @@ def run_campaign(plan: CampaignPlan, out: str | Path, backend: Backend | None = 
     ``progress(done, total)`` after every run appended. Raises ``CampaignError`` for a folder that holds
     another campaign (or is in use by one); KeyboardInterrupt leaves every finished run in the file.
     """
-    from cellstress.campaign.plan import open_manifest
-    from cellstress.campaign.store import RUNS, FolderLock, RunWriter, read_runs, record_key
+    from cellstress.campaign.store import RUNS, FolderLock, RunWriter, open_manifest, read_runs, record_key
     from cellstress.campaign.table import markdown, write_tables
     from cellstress.report.campaign import write_campaign_report
 

@@ -9,20 +9,33 @@ cellstress version); a resumed campaign must match it, or its runs would silentl
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Any
 
-from cellstress.errors import CellstressError
+from cellstress.campaign.paper import paper_table
+from cellstress.cell.load import BUILTIN_CELLS, load_cell
+from cellstress.core import registry
+from cellstress.core.errors import CellstressError
+from cellstress.core.version import __version__
+from cellstress.searchers import make_searcher, searcher_class, searcher_names
 
 FORMAT = 1
 MANIFEST = "campaign.json"
 # the paper's experiment (Huck et al. 2020, Sec. V): three flawed scenarios, MCTS1/MCTS2 against random
 DEFAULT_CELLS: tuple[str, ...] = ("s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap")
-DEFAULT_SEARCHERS: tuple[str, ...] = ("random", "mcts", "mcts-commit")
 DEFAULT_SEEDS = 10
 DEFAULT_BUDGET = 200
 UNTIL = "first"  # the paper stops a run at its first hazard; a failed run counts as the budget
+
+
+def paper_searchers() -> tuple[str, ...]:
+    """The searchers of the paper's experiment, the default ``--searchers``: those registered with a
+    ``paper_name``, in the order of the paper's Table III (Random, MCTS1, MCTS2)."""
+    order = paper_table().algorithms
+    named = {cls.paper_name: n for n, cls in registry.load_all("searchers").items()
+             if getattr(cls, "paper_name", None)}
+    return tuple(named[a] for a in order if a in named) + tuple(n for a, n in named.items() if a not in order)
 
 
 class CampaignError(CellstressError):
@@ -118,18 +131,14 @@ def resolve(cells: tuple[str, ...], searchers: tuple[str, ...], seeds: int, budg
     ``options`` (``--set``) go to every searcher that has them; each must belong to at least one.
 
     Raises ``CampaignError`` (or the cell's ``CellError``) for anything the user must fix."""
-    from dataclasses import asdict, fields
-
-    from cellstress import __version__
-    from cellstress.cell.load import BUILTIN_CELLS, load_cell
-    from cellstress.search import SEARCHERS, make_searcher
 
     for opt, value in (("seeds", seeds), ("budget", budget)):
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise CampaignError(f"--{opt} must be a whole number >= 1, not {value!r}")
-    unknown = [s for s in searchers if s not in SEARCHERS]
+    known = searcher_names()
+    unknown = [s for s in searchers if s not in known]
     if unknown:
-        raise CampaignError(f"--searchers: unknown searcher {unknown[0]!r} (choose from {', '.join(SEARCHERS)})")
+        raise CampaignError(f"--searchers: unknown searcher {unknown[0]!r} (choose from {', '.join(known)})")
     refs = []
     for ref in cells:
         try:
@@ -144,7 +153,7 @@ def resolve(cells: tuple[str, ...], searchers: tuple[str, ...], seeds: int, budg
     if twice:
         raise CampaignError(f"--cells: two cells are named {twice[0]!r}; rows of the table are keyed by name")
     options = dict(options or {})
-    has = {s: {f.name for f in fields(SEARCHERS[s])} for s in searchers}
+    has = {s: {f.name for f in fields(searcher_class(s))} for s in searchers}
     orphans = sorted(o for o in options if not any(o in has[s] for s in searchers))
     if orphans:
         raise CampaignError(f"--set {orphans[0]}: none of the searchers ({', '.join(searchers)}) has this option")
@@ -196,34 +205,3 @@ def manifest_difference(old: dict[str, Any], new: dict[str, Any]) -> str | None:
         if old.get(key) != new[key]:
             return f"{label} differs: {_show(old.get(key))} there, {_show(new[key])} here"
     return None
-
-
-def write_json_atomic(path: Path, doc: Any) -> None:
-    """Write ``doc`` as sorted, indented JSON, atomically (never half a file)."""
-    from cellstress.campaign.store import atomic_write
-
-    atomic_write(path, (json.dumps(doc, sort_keys=True, indent=1, allow_nan=False) + "\n").encode("utf-8"))
-
-
-def open_manifest(out: Path, plan: CampaignPlan) -> bool:
-    """Write ``out/campaign.json``, or check that the one there matches ``plan``. True if it existed."""
-    from cellstress.campaign.store import RUNS
-
-    path = out / MANIFEST
-    new = plan.manifest()
-    if not path.exists():
-        if (out / RUNS).exists():
-            raise CampaignError(f"--out {out}: has a {RUNS} but no {MANIFEST}; use an empty folder")
-        write_json_atomic(path, new)
-        return False
-    try:
-        old = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise CampaignError(f"--out {out}: {MANIFEST} is not readable ({exc})") from None
-    if not isinstance(old, dict):
-        raise CampaignError(f"--out {out}: {MANIFEST} is not a campaign manifest")
-    diff = manifest_difference(old, new)
-    if diff is not None:
-        raise CampaignError(f"--out {out} holds a campaign with other options: {diff} "
-                            f"(resume with the same options, or use another --out)")
-    return True

@@ -15,16 +15,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from cellstress.campaign.plan import MANIFEST, CampaignError, CampaignPlan, RunKey
-from cellstress.search.result import atomic_write, json_ready
+from cellstress.campaign.plan import MANIFEST, CampaignError, CampaignPlan, RunKey, manifest_difference
+from cellstress.core.io import atomic_write, atomic_write_text, canonical_json, json_line, json_ready
 
 RUNS = "runs.jsonl"
 LOCK = ".campaign.lock"
-
-
-def dumps(record: dict[str, Any]) -> str:
-    """A record as one line of text (no newline): sorted keys, no spaces, no NaN."""
-    return json.dumps(json_ready(record), sort_keys=True, separators=(",", ":"), allow_nan=False)
 
 
 def record_key(rec: dict[str, Any]) -> RunKey:
@@ -66,16 +61,11 @@ def read_runs(path: Path, plan: CampaignPlan) -> Loaded:
             raise CampaignError(f"{path}: line {n} ({key.cell}, {key.searcher}, seed {key.seed}) is not a run "
                                 f"of the campaign in {MANIFEST}")
         old = records.get(key)
-        if old is not None and dumps(old) != dumps(rec):
+        if old is not None and json_line(old) != json_line(rec):
             raise CampaignError(f"{path}: line {n} repeats run ({key.cell}, {key.searcher}, seed {key.seed}) "
                                 f"with a different outcome")
         records[key] = rec
     return Loaded(records, dropped)
-
-
-def rewrite_text(path: Path, text: str) -> None:
-    """Write a whole text file atomically."""
-    atomic_write(path, text.encode("utf-8"))
 
 
 class RunWriter:
@@ -86,7 +76,7 @@ class RunWriter:
         self._fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
 
     def append(self, record: dict[str, Any]) -> None:
-        data = (dumps(record) + "\n").encode("utf-8")
+        data = (json_line(record) + "\n").encode("utf-8")
         view = memoryview(data)
         while view:  # a regular file takes the whole line at once; loop only for safety
             n = os.write(self._fd, view)
@@ -130,3 +120,25 @@ class FolderLock:
         if self._f is not None:
             self._f.close()  # closing releases the lock
             self._f = None
+
+
+def open_manifest(out: Path, plan: CampaignPlan) -> bool:
+    """Write ``out/campaign.json``, or check that the one there matches ``plan``. True if it existed."""
+    path = out / MANIFEST
+    new = plan.manifest()
+    if not path.exists():
+        if (out / RUNS).exists():
+            raise CampaignError(f"--out {out}: has a {RUNS} but no {MANIFEST}; use an empty folder")
+        atomic_write_text(path, canonical_json(new))
+        return False
+    try:
+        old = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise CampaignError(f"--out {out}: {MANIFEST} is not readable ({exc})") from None
+    if not isinstance(old, dict):
+        raise CampaignError(f"--out {out}: {MANIFEST} is not a campaign manifest")
+    diff = manifest_difference(old, new)
+    if diff is not None:
+        raise CampaignError(f"--out {out} holds a campaign with other options: {diff} "
+                            f"(resume with the same options, or use another --out)")
+    return True

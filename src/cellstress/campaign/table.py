@@ -193,9 +193,9 @@ def csv_text(rows: list[Row]) -> str:
 
 def write_tables(out: Path, records: list[dict[str, Any]], plan: CampaignPlan) -> list[Row]:
     """Write ``table.md`` and ``table.csv`` (atomically) from the records; returns the rows."""
-    from cellstress.campaign.store import rewrite_text
+    from cellstress.core.io import atomic_write_text
 
     rows = summarize(records, [c.name for c in plan.cells], [s.name for s in plan.searchers], plan.budget)
-    rewrite_text(out / TABLE_MD, markdown(rows, plan))
-    rewrite_text(out / TABLE_CSV, csv_text(rows))
+    atomic_write_text(out / TABLE_MD, markdown(rows, plan))
+    atomic_write_text(out / TABLE_CSV, csv_text(rows))
     return rows

@@ -79,7 +79,7 @@ def simulator(source: str, sha256: str):
 
 def execute(spec: RunSpec) -> dict[str, Any]:
     """Run one search and return its record for ``runs.jsonl``."""
-    from cellstress.search import search
+    from cellstress.searchers import search
 
     sim = simulator(spec.cell.source, spec.cell.sha256)
     result = search(sim, spec.searcher.name, spec.budget, spec.seed, **spec.searcher.params_dict)

@@ -6,15 +6,16 @@ import difflib
 import hashlib
 import types
 import typing
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
 
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from cellstress.cell.schema import CellSpec
-from cellstress.errors import CellError
+from cellstress.cell.schema import CRITERIA, DEVICE_KINDS, CellSpec
+from cellstress.core import registry
+from cellstress.core.errors import CellError, CellstressError
 
 BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap", "all-flaws")
 
@@ -71,8 +72,7 @@ def safe_load_yaml(text: str):
 
 
 # pydantic puts the tag of a tagged-union branch into an error's location; it is not a field name
-_UNION_TAGS = {"laser-scanner", "light-curtain", "capsules-auto", "capsules-list", "function-after",
-               "function-before"}
+_UNION_TAGS = {*DEVICE_KINDS, *CRITERIA, "capsules-auto", "capsules-list", "function-after", "function-before"}
 _TYPE_WORDS = {"list": "list", "str": "single text value", "int": "single number", "float": "single number",
                "bool": "single true/false value"}
 
@@ -171,10 +171,11 @@ def _validation_problem(err: dict) -> tuple[str, str]:
         return _field_path(loc), f"needs at least {expected} items, got {got}"
     if kind == "union_tag_invalid":
         tag, expected = ctx.get("tag"), ctx.get("expected_tags", "")
-        return _field_path(loc + ("type",)), f"unknown device type {tag!r}; expected one of {expected}"
+        what = "criterion" if loc and loc[0] == "criterion" else "device type"
+        return _field_path(loc + ("type",)), f"unknown {what} {tag!r}; expected one of {expected}"
     if kind == "union_tag_not_found":
-        return (_field_path(loc + ("type",)),
-                "required field is missing (the device type: 'laser-scanner' or 'light-curtain')")
+        kinds = " or ".join(repr(k) for k in DEVICE_KINDS)
+        return _field_path(loc + ("type",)), f"required field is missing (the device type: {kinds})"
     if kind == "literal_error" and loc and loc[-1] == "capsules-auto":
         return _field_path(loc), f"must be 'auto' or a list of capsules, got {_describe(value)}"
     if kind in ("tuple_type", "list_type"):
@@ -272,7 +273,6 @@ def load_cell(name_or_path: str | Path) -> Cell:
 
 def check_geometry(cell: Cell) -> None:
     """Checks that need more than one field: the URDF, the waypoints against it, the start pose."""
-    from cellstress.errors import CellstressError
     from cellstress.robot.model import load_robot, resolve_urdf
     from cellstress.sim.geometry import point_segment_2d, polygon_distance
 
@@ -315,3 +315,16 @@ def check_geometry(cell: Cell) -> None:
         for a, b in zip(fence.points, fence.points[1:], strict=False):
             if fence.bottom < 0.5 and point_segment_2d(x, y, a[0], a[1], b[0], b[1]) < r:
                 raise CellError(src, where, f"({x}, {y}) is inside or touching a fence (fences[{i}])")
+
+
+def with_criterion(cell: Cell, name: str | None) -> Cell:
+    """``cell`` judged by the criterion ``name`` (its tolerances kept, its other options at their defaults); the
+    cell itself if ``name`` is None or already its criterion. CellstressError for an unknown name."""
+    if name is None or name == cell.spec.criterion.type:
+        return cell
+    if name not in CRITERIA:
+        raise CellstressError(f"unknown criterion {name!r} (choose from {', '.join(CRITERIA)})")
+    old = cell.spec.criterion
+    crit = registry.load("criteria", name)(distance_tolerance=old.distance_tolerance,
+                                           speed_tolerance=old.speed_tolerance)
+    return replace(cell, spec=cell.spec.model_copy(update={"criterion": crit}))

@@ -2,17 +2,18 @@
 
 Lengths are metres, angles degrees, times seconds. The frame is right-handed with z up; the built-in cells
 put the robot base near the origin, the upper (front) end of the cell at +y and the lower (back) end at -y.
+
+The kinds of safety device and of criterion are plug-ins: their records come from the ``cellstress.devices``
+and ``cellstress.criteria`` registries (``core.registry``), tagged by their ``type`` field, so a device kind
+installed by another package is a valid ``devices`` entry without any change here.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal, Union
 
 from pydantic import (
-    AfterValidator,
-    BaseModel,
-    ConfigDict,
     Discriminator,
     Field,
     Tag,
@@ -20,57 +21,17 @@ from pydantic import (
     model_validator,
 )
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Point2 = tuple[Finite, Finite]
-Point3 = tuple[Finite, Finite, Finite]
-PositiveTime = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
-Length = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+from cellstress.core import registry
+from cellstress.core.fields import Finite, Length, NonNegative, Point2, Point3, Polygon, PositiveTime, Record
 
+DEFAULT_CRITERION = "contact-while-moving"
 
-class _Record(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-def _segments_cross(a: Point2, b: Point2, c: Point2, d: Point2) -> bool:
-    """True when segments ab and cd properly intersect (touching at shared endpoints is not a crossing)."""
-
-    def orient(p: Point2, q: Point2, r: Point2) -> float:
-        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
-
-    o1, o2, o3, o4 = orient(a, b, c), orient(a, b, d), orient(c, d, a), orient(c, d, b)
-    return (o1 * o2 < 0) and (o3 * o4 < 0)
-
-
-def check_simple_polygon(points: tuple[Point2, ...]) -> tuple[Point2, ...]:
-    if len(points) < 3:
-        raise ValueError(f"a polygon needs at least 3 points, got {len(points)}")
-    n = len(points)
-    # crossings first: a symmetric bow-tie has zero signed area, and "intersects itself" is the real problem
-    for i in range(n):
-        for j in range(i + 1, n):
-            if j in (i, (i + 1) % n) or i == (j + 1) % n:
-                continue
-            if _segments_cross(points[i], points[(i + 1) % n], points[j], points[(j + 1) % n]):
-                raise ValueError(f"the polygon intersects itself (edge {i} from point {i} crosses edge {j} "
-                                 f"from point {j})")
-    area2 = sum(points[i][0] * points[(i + 1) % n][1] - points[(i + 1) % n][0] * points[i][1]
-                for i in range(n))
-    if abs(area2) < 1e-12:
-        raise ValueError("the polygon has zero area")
-    return points
-
-
-# A simple polygon; validated per polygon so that errors name the polygon's index (table.polygons[1]).
-Polygon = Annotated[tuple[Point2, ...], AfterValidator(check_simple_polygon)]
-
-
-class Pose(_Record):
+class Pose(Record):
     xyz: Point3 = (0.0, 0.0, 0.0)
     yaw_deg: float = Field(0.0, allow_inf_nan=False)
 
 
-class CapsuleSpec(_Record):
+class CapsuleSpec(Record):
     """A capsule fixed to a robot link, in that link's frame."""
 
     link: str
@@ -79,7 +40,7 @@ class CapsuleSpec(_Record):
     radius: Length
 
 
-class TaskSpec(_Record):
+class TaskSpec(Record):
     """A cyclic pick-and-place: joint waypoints visited in order, then back to the first."""
 
     waypoints_deg: tuple[tuple[float, ...], ...] = Field(min_length=2)
@@ -111,7 +72,7 @@ CapsulesField = Annotated[
 ]
 
 
-class RobotSpec(_Record):
+class RobotSpec(Record):
     urdf: str = "ur10"
     base: Pose = Pose()
     capsules: CapsulesField = "auto"
@@ -120,12 +81,12 @@ class RobotSpec(_Record):
     task: TaskSpec
 
 
-class TableSpec(_Record):
+class TableSpec(Record):
     height: Length = 0.85
     polygons: tuple[Polygon, ...] = Field(min_length=1)
 
 
-class FenceSpec(_Record):
+class FenceSpec(Record):
     """A run of fence panels along a polyline, from ``bottom`` to ``top`` above the floor."""
 
     points: tuple[Point2, ...] = Field(min_length=2)
@@ -142,7 +103,7 @@ class FenceSpec(_Record):
         return self
 
 
-class FloorSpec(_Record):
+class FloorSpec(Record):
     """The walkable rectangle: the worker cannot leave it."""
 
     xmin: Finite
@@ -157,37 +118,29 @@ class FloorSpec(_Record):
         return self
 
 
-class LaserScannerSpec(_Record):
-    type: Literal["laser-scanner"]
-    name: str
-    polygon: Polygon
-    height: Annotated[float, Field(ge=0.0, le=1.0)] = 0.3
-    response_time: PositiveTime = 0.35
+def _tag(value: Any, default: str | None = None) -> str | None:
+    """The ``type`` tag of a record or of its mapping in a file (``default`` when a mapping has none)."""
+    if isinstance(value, dict):
+        return value.get("type", default)
+    return getattr(value, "type", default)
 
 
-class LightCurtainSpec(_Record):
-    type: Literal["light-curtain"]
-    name: str
-    start: Point2
-    end: Point2
-    bottom: NonNegative = 0.2
-    top: Length = 1.8
-    response_time: PositiveTime = 0.05
-    resolution_mm: Annotated[float, Field(gt=0.0, le=200.0)] = 30.0
-
-    @model_validator(mode="after")
-    def _shape(self) -> LightCurtainSpec:
-        if self.start == self.end:
-            raise ValueError("start and end are the same point")
-        if self.top <= self.bottom:
-            raise ValueError(f"top ({self.top}) must be above bottom ({self.bottom})")
-        return self
+def _tagged_union(group: str, default: str | None = None):
+    """The records of a registry group as one union, told apart by their ``type`` tag."""
+    kinds = registry.load_all(group)
+    if len(kinds) == 1:
+        return next(iter(kinds.values()))
+    members = tuple(Annotated[cls, Tag(name)] for name, cls in kinds.items())
+    return Annotated[Union[members], Discriminator(lambda v: _tag(v, default))]  # noqa: UP007 (a built tuple)
 
 
-DeviceSpec = Annotated[LaserScannerSpec | LightCurtainSpec, Field(discriminator="type")]
+DEVICE_KINDS: tuple[str, ...] = registry.names("devices")
+CRITERIA: tuple[str, ...] = registry.names("criteria")
+DeviceSpec = _tagged_union("devices")
+CriterionSpec = _tagged_union("criteria", DEFAULT_CRITERION)
 
 
-class Anthropometry(_Record):
+class Anthropometry(Record):
     """Body dimensions; defaults are the paper's Table I."""
 
     height: Annotated[float, Field(gt=1.0, lt=2.5)] = 1.78
@@ -196,7 +149,7 @@ class Anthropometry(_Record):
     hand: Length = 0.18
 
 
-class StartSpec(_Record):
+class StartSpec(Record):
     xy: Point2
     heading_deg: float = Field(allow_inf_nan=False)
 
@@ -208,7 +161,7 @@ class NamedStart(StartSpec):
     phase: NonNegative | None = None
 
 
-class HumanSpec(_Record):
+class HumanSpec(Record):
     start: StartSpec
     # the start points a search chooses from, one per episode (its first decision); empty: ``start`` only
     starts: tuple[NamedStart, ...] = ()
@@ -227,26 +180,13 @@ class HumanSpec(_Record):
         return v
 
 
-CRITERIA = ("contact-while-moving", "iso15066")
-
-
-class CriterionSpec(_Record):
-    """What is unsafe: ``contact-while-moving`` (the paper) or ``iso15066`` (force limits per body region;
-    ``payload`` [kg] is added to the robot's reflected mass, see docs/criteria.md)."""
-
-    type: Literal["contact-while-moving", "iso15066"] = "contact-while-moving"
-    distance_tolerance: Annotated[float, Field(ge=0.0, le=0.1)] = 0.0
-    speed_tolerance: Annotated[float, Field(ge=0.0, le=0.1)] = 0.001
-    payload: Annotated[float, Field(ge=0.0, le=1000.0)] = 2.0
-
-
-class SimulationSpec(_Record):
+class SimulationSpec(Record):
     dt: PositiveTime = 0.05
     steps_per_action: Annotated[int, Field(ge=1, le=100)] = 4
     actions_per_episode: Annotated[int, Field(ge=1, le=100)] = 8
 
 
-class CellSpec(_Record):
+class CellSpec(Record):
     name: str
     description: str = ""
     robot: RobotSpec
@@ -255,7 +195,7 @@ class CellSpec(_Record):
     floor: FloorSpec
     devices: tuple[DeviceSpec, ...] = ()
     human: HumanSpec
-    criterion: CriterionSpec = CriterionSpec()
+    criterion: CriterionSpec = Field(default_factory=lambda: registry.load("criteria", DEFAULT_CRITERION)())
     simulation: SimulationSpec = SimulationSpec()
 
     @field_validator("devices")

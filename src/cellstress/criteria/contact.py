@@ -1,64 +1,78 @@
 """The paper's criterion: no contact unless the robot stands still, U = {s : v_R > 0, d_HR = 0}.
 
-Tolerances: contact means d_HR <= ``distance_tolerance`` (default 0: touching or overlapping); moving means
-v_R > ``speed_tolerance`` (default 1 mm/s, so that the float residue of a completed stop is a standstill).
-The simulator evaluates the predicate in its compiled loop with these two numbers; this object is the
-readable reference and the reward.
+The simulator evaluates it in its compiled loop (``kernel_test``: d_HR <= distance tolerance and v_R above the
+speed tolerance); ``judge`` is the same predicate on a ``Contact``, the readable reference.
 
 Reward (paper, sec. IV): the safety index c_S = (d_HR^2 + 1) exp(-v_R) is large when safe. After each action
 k < n the search receives 1 / c_S; an episode that ends at k = n without reaching U receives -c_S instead.
+Reaching U ends the episode and is rewarded like any other step (1/c_S = e^{v_R}, since d_HR = 0): the paper
+gives no bonus, and neither do we.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+from typing import Any, Literal
 
-from cellstress.cell.schema import CriterionSpec
+from cellstress.core.records import Contact, KernelTest, Measures
+from cellstress.criteria.base import CriterionRecord, safety_index
 
 
 @dataclass(frozen=True)
-class ContactWhileMoving:
-    distance_tolerance: float = 0.0
-    speed_tolerance: float = 0.001
+class MovingContact:
+    """The verdict of ``contact-while-moving`` on one contact."""
 
-    name = "contact-while-moving"
+    touching: bool
+    moving: bool
+    v_r: float
+
+    @property
+    def unsafe(self) -> bool:
+        return self.touching and self.moving
+
+    @property
+    def reason(self) -> str | None:
+        return f"contact while the robot moves at {self.v_r:.3f} m/s" if self.unsafe else None
+
+    def summary(self) -> str:
+        return self.reason or ("contact with the robot at a standstill" if self.touching else "no contact")
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"unsafe": self.unsafe, "reason": self.reason, "v_R": self.v_r}
+
+
+class ContactWhileMoving(CriterionRecord):
+    type: Literal["contact-while-moving"] = "contact-while-moving"
 
     def is_unsafe(self, d_hr: float, v_r: float) -> bool:
         return d_hr <= self.distance_tolerance and v_r > self.speed_tolerance
 
+    def kernel_test(self) -> KernelTest:
+        return KernelTest(self.distance_tolerance, self.speed_tolerance)
+
+    def judge(self, contact: Contact) -> MovingContact:
+        return MovingContact(contact.d_hr <= self.distance_tolerance, contact.v_r > self.speed_tolerance,
+                             contact.v_r)
+
+    def severity(self, contact: Contact) -> None:
+        return None
+
     @staticmethod
     def safety_index(d_hr: float, v_r: float) -> float:
-        return (d_hr * d_hr + 1.0) * math.exp(-v_r)
+        return safety_index(d_hr, v_r)
 
-    def reward(self, d_hr: float, v_r: float, last_action: bool, unsafe: bool) -> float:
-        """Reward after one action (the paper's eq. for R; an unsafe end is rewarded like any other step)."""
-        c = self.safety_index(d_hr, v_r)
-        if last_action and not unsafe:
-            return -c
-        return 1.0 / c
+    def reward(self, horizon: int) -> SafetyIndexReward:
+        return SafetyIndexReward(self)
 
 
-def criterion_for(spec: CriterionSpec):
-    """The criterion object of a cell file's ``criterion`` record."""
-    if spec.type == "iso15066":
-        from cellstress.criteria.iso15066 import Iso15066
+class SafetyIndexReward:
+    """The paper's reward and risk (1/c_S) for one action end, from a criterion's ``safety_index``."""
 
-        return Iso15066(spec.distance_tolerance, spec.speed_tolerance, spec.payload)
-    return ContactWhileMoving(spec.distance_tolerance, spec.speed_tolerance)
+    def __init__(self, criterion):
+        self.criterion = criterion
+        self.safety_index = criterion.safety_index
 
-
-def with_criterion(cell, name: str | None):
-    """``cell`` judged by the criterion ``name`` (its tolerances kept); the cell itself if ``name`` is None or
-    already its criterion. CellstressError for an unknown name."""
-    from dataclasses import replace
-
-    from cellstress.cell.schema import CRITERIA
-    from cellstress.errors import CellstressError
-
-    if name is None or name == cell.spec.criterion.type:
-        return cell
-    if name not in CRITERIA:
-        raise CellstressError(f"unknown criterion {name!r} (choose from {', '.join(CRITERIA)})")
-    crit = cell.spec.criterion.model_copy(update={"type": name})
-    return replace(cell, spec=cell.spec.model_copy(update={"criterion": crit}))
+    def __call__(self, measures: Measures, last_action: bool, unsafe: bool) -> tuple[float, float]:
+        """(reward, risk) after one action; risk = 1/c_S."""
+        c = self.safety_index(measures[0], measures[1])
+        return (-c if last_action and not unsafe else 1.0 / c), 1.0 / c

@@ -7,22 +7,27 @@ A contact (d_HR <= distance tolerance) is **unsafe** when
 
 F = v_rel * sqrt(mu * k) (ISO/TS 15066 Annex A, eq. A.6 rearranged for F), with the reduced mass
 mu = (1/m_H + 1/m_R)^-1, the region's effective mass m_H and spring constant k (Table A.3), the robot's
-effective mass m_R at the contact point along the contact normal n (the reflected mass (n J M^-1 J^T n)^-1 from
-pinocchio's joint-space inertia M and point Jacobian J, plus the payload), and v_rel the speed of the robot's
-contact point towards the human along n, v_rel = max(0, n . J q_dot). The worker's own motion is not included:
-see docs/criteria.md for why. Every number and its source: docs/criteria.md.
+effective mass m_R at the contact point along the contact normal n (the reflected mass the simulator computes
+with pinocchio, ``robot.dynamics``, plus the payload), and v_rel the speed of the robot's contact point towards
+the human along n. The worker's own motion is not included: see docs/criteria.md for why. Every number and its
+source: docs/criteria.md.
 
-Body regions: ``body_region`` maps a contact on the worker model (part and point) to an ISO/TS 15066 region.
-Reward (``IsoReward``): risk grows with the ratio of the predicted force to the transient limit, and is guarded
-against reward hacking (see its docstring).
+The simulator has no fast path for this criterion: it hands every contact to ``judge`` (``core.records.Contact``:
+body region, normal, v_rel and reflected mass at the closest points), and the force ratio at every action end to
+the reward (``severity``). Reward (``IsoReward``): risk grows with the ratio of the predicted force to the
+transient limit, and is guarded against reward hacking (see its docstring).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Annotated, Any, Literal
 
-import numpy as np
+from pydantic import Field
+
+from cellstress.core.records import Contact, Measures
+from cellstress.criteria.base import CriterionRecord, safety_index
 
 # ---- ISO/TS 15066:2016 Annex A ------------------------------------------------------------------------------
 # region: (quasi-static force limit [N] (Table A.2), effective spring constant [N/mm], effective mass [kg]
@@ -44,14 +49,6 @@ REGIONS: dict[str, tuple[float, float, float]] = {
 TRANSIENT_FACTOR = 2.0
 HEAD_REGIONS = ("skull-forehead", "face")  # no contact while the robot moves
 
-# Body landmarks as fractions of body height (Winter, Fig. 4.1, after Drillis & Contini): knee 0.285 H,
-# chest (nipple) 0.720 H; the iliac crest (top of the pelvis) is taken at 0.600 H (our round number).
-KNEE = 0.285
-PELVIS_TOP = 0.600
-CHEST_BOTTOM = 0.720
-NECK_HALF_WIDTH = 0.07  # m: the trunk capsule's top within this of the mid-plane is the neck
-
-
 def transient_limit(region: str) -> float:
     return TRANSIENT_FACTOR * REGIONS[region][0]
 
@@ -69,78 +66,9 @@ def region_force(region: str, v_rel: float, m_robot: float) -> float:
     return peak_force(v_rel, m_robot, m_h, k * 1000.0)
 
 
-def reflected_mass(J_point: np.ndarray, M: np.ndarray, n: np.ndarray) -> float:
-    """(n . J M^-1 J^T n)^-1: the robot's inertia felt at a point along the unit direction n (inf if the joints
-    cannot move the point along n)."""
-    u = J_point.T @ n
-    w = float(u @ np.linalg.solve(M, u))
-    return math.inf if w <= 1e-12 else 1.0 / w
-
-
-def point_dynamics(model, data, q, joint_id: int, point) -> tuple[np.ndarray, np.ndarray]:
-    """(3 x nv linear Jacobian of a point fixed to pinocchio joint ``joint_id``, given in the model's world frame;
-    nv x nv joint-space inertia matrix M(q)) from pinocchio."""
-    import pinocchio as pin
-
-    pin.computeJointJacobians(model, data, q)
-    Jj = np.asarray(pin.getJointJacobian(model, data, joint_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED))
-    Jj = Jj.reshape(6, model.nv)  # (eigenpy hands a 6 x 1 matrix back as a vector)
-    r = np.asarray(point, dtype=float) - data.oMi[joint_id].translation
-    skew = np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
-    M = np.asarray(pin.crba(model, data, q)).reshape(model.nv, model.nv)  # upper triangle filled
-    return Jj[:3] - skew @ Jj[3:], np.triu(M) + np.triu(M, 1).T
-
-
-def body_region(part: int, point, pose, height: float, upper_arm: float, forearm: float) -> str:
-    """The ISO/TS 15066 region of a contact on body part ``part`` (index into BODY_PARTS) at ``point``.
-
-    ``pose`` is ``sim.scene.BodyPose`` of the worker at that step. Legs: lower legs below the knee, thighs
-    above. Trunk: pelvis below the iliac crest; above it the back half is back/shoulders, the front half the
-    abdomen up to the chest line and the chest above; the top cap within 7 cm of the mid-plane is the neck.
-    Head: the face is the front lower part (the outward direction within 73 degrees of forward and less than
-    17 degrees above the head centre), the rest skull/forehead, the underside the neck. Hanging arms: upper arm,
-    forearm, hand by the distance from the shoulder. The reach volumes (where a hand *could* be) count as hand
-    beyond upper arm + forearm from the shoulder and as forearm within it.
-    """
-    p = np.asarray(point, dtype=float)
-    fwd, left, up = pose.trunk[:, 0], pose.trunk[:, 1], pose.trunk[:, 2]
-    if part in (0, 1):
-        return "lower-legs" if p[2] < KNEE * height else "thighs"
-    if part == 2:
-        hip = pose.a[2]
-        s = float((p - hip) @ up)  # height along the trunk axis above the hip
-        out = p - (hip + s * up)
-        rise = 0.818 - 0.530
-        if s < (PELVIS_TOP - 0.530) * height:
-            return "pelvis"
-        if s > rise * height and abs(float(out @ left)) < NECK_HALF_WIDTH:
-            return "neck"
-        if float(out @ fwd) < 0.0 or s > rise * height:
-            return "back-shoulders"
-        return "chest" if s >= (CHEST_BOTTOM - 0.530) * height else "abdomen"
-    if part == 3:
-        d = p - pose.a[3]
-        r = float(np.linalg.norm(d))
-        if r <= 1e-12:
-            return "skull-forehead"
-        d = d / r
-        if float(d @ up) < -0.8:
-            return "neck"
-        if float(d @ fwd) > 0.3 and float(d @ up) < 0.3:
-            return "face"
-        return "skull-forehead"
-    side = (part - 4) % 2
-    dist = float(np.linalg.norm(p - pose.shoulders[side]))
-    if part in (4, 5):
-        if dist < upper_arm:
-            return "upper-arms"
-        return "forearms" if dist < upper_arm + forearm else "hands"
-    return "hands" if dist >= upper_arm + forearm else "forearms"
-
-
 @dataclass(frozen=True)
-class Contact:
-    """The force estimate of one step (at the closest points, whether touching or not)."""
+class ForceVerdict:
+    """The force estimate of one contact (at the closest points, whether touching or not) and its judgement."""
 
     region: str
     normal: tuple[float, float, float]  # unit, from the robot towards the human
@@ -159,23 +87,23 @@ class Contact:
     def ratio(self) -> float:
         return self.force / self.limit
 
-    def as_dict(self) -> dict:
+    def summary(self) -> str:
+        text = f"{self.force:.0f} N against a {self.limit:.0f} N limit ({self.region})"
+        return f"{self.reason}" if self.reason else text
+
+    def as_dict(self) -> dict[str, Any]:
         return {"region": self.region, "normal": list(self.normal), "v_rel": self.v_rel,
                 "m_robot": self.m_robot, "m_human": self.m_human, "k_N_per_m": self.k, "force_N": self.force,
                 "limit_N": self.limit, "ratio": self.ratio, "unsafe": self.unsafe, "reason": self.reason}
 
 
-@dataclass(frozen=True)
-class Iso15066:
-    """The ``iso15066`` criterion's numbers (the physics is in ``ForceModel``)."""
+class Iso15066(CriterionRecord):
+    """``payload`` [kg] is added to the robot's reflected mass (see docs/criteria.md)."""
 
-    distance_tolerance: float = 0.0
-    speed_tolerance: float = 0.001
-    payload: float = 2.0
+    type: Literal["iso15066"] = "iso15066"
+    payload: Annotated[float, Field(ge=0.0, le=1000.0)] = 2.0
 
-    name = "iso15066"
-
-    def judge(self, region: str, force: float, moving: bool) -> tuple[bool, str | None]:
+    def rule(self, region: str, force: float, moving: bool) -> tuple[bool, str | None]:
         """(unsafe, reason) of a contact on ``region`` with the predicted force [N]."""
         if moving and region in HEAD_REGIONS:
             return True, f"{region} contact while the robot moves"
@@ -183,73 +111,34 @@ class Iso15066:
             return True, f"{force:.0f} N > {transient_limit(region):.0f} N transient limit ({region})"
         return False, None
 
+    def kernel_test(self) -> None:
+        return None
+
+    def assess(self, contact: Contact) -> ForceVerdict:
+        """The force estimate at ``contact`` and its verdict."""
+        m_r = contact.reflected_mass + self.payload
+        _, k, m_h = REGIONS[contact.region]
+        force = peak_force(contact.v_rel, m_r, m_h, k * 1000.0)
+        touching = bool(contact.d_hr <= self.distance_tolerance)
+        moving = bool(contact.v_r > self.speed_tolerance)
+        unsafe, reason = self.rule(contact.region, force, moving) if touching else (False, None)
+        return ForceVerdict(contact.region, contact.normal, contact.v_rel, m_r, m_h, k * 1000.0, force,
+                            transient_limit(contact.region), touching, moving, unsafe, reason)
+
+    def judge(self, contact: Contact) -> ForceVerdict:
+        return self.assess(contact)
+
+    def severity(self, contact: Contact) -> float:
+        """The predicted force over the transient limit at the closest points, as if they touched now."""
+        return float(self.assess(contact).ratio)
+
     @staticmethod
     def safety_index(d_hr: float, v_r: float) -> float:
         """The paper's c_S (reported alongside; the search uses ``IsoReward``)."""
-        return (d_hr * d_hr + 1.0) * math.exp(-v_r)
+        return safety_index(d_hr, v_r)
 
-
-class ForceModel:
-    """Contact force estimates for a simulator layout: pinocchio dynamics at the robot's joint state of a step."""
-
-    def __init__(self, layout, criterion: Iso15066):
-        from cellstress.robot.model import load_pinocchio
-
-        self.layout = layout
-        self.crit = criterion
-        self.model = load_pinocchio(layout.robot.urdf)
-        self.data = self.model.createData()
-        P = layout.params
-        self.P = P
-        self.R_base = np.asarray(P.base[:3, :3])
-        self.t_base = np.asarray(P.base[:3, 3])
-        b = layout.body
-        self.height, self.upper_arm, self.forearm = b.height, b.upper_arm, b.forearm
-
-    def joint_state(self, row) -> tuple[np.ndarray, np.ndarray]:
-        from cellstress.sim import scene
-
-        return scene.joint_state(self.layout, row)
-
-    def assess(self, row) -> Contact:
-        """The force estimate at a metric row (closest robot point, body part, normal from the geometry)."""
-        from cellstress.sim import kernels as K
-        from cellstress.sim import scene
-
-        P = self.P
-        link, part = int(row[K.M_LINK]), int(row[K.M_PART])
-        rp = np.array(row[K.M_RX:K.M_RZ + 1], dtype=float)
-        hp = np.array(row[K.M_HX:K.M_HZ + 1], dtype=float)
-        pose = scene.body_pose(self.layout, row[K.M_X], row[K.M_Y], row[K.M_HEADING], row[K.M_FWD], row[K.M_LAT])
-        q, qd = self.joint_state(row)
-        n = scene.contact_normal(self.layout, row, pose)
-        region = body_region(part, hp, pose, self.height, self.upper_arm, self.forearm)
-        j = int(P.cap_joint[link])
-        touching = bool(row[K.M_D] <= self.crit.distance_tolerance)
-        moving = bool(row[K.M_V] > self.crit.speed_tolerance)
-        if j < 0:  # a capsule on the fixed base
-            v_rel, m_r = 0.0, math.inf
-        else:
-            pb = self.R_base.T @ (rp - self.t_base)  # pinocchio works in the robot base frame
-            nb = self.R_base.T @ n
-            Jp, M = point_dynamics(self.model, self.data, q, j + 1, pb)
-            m_r = reflected_mass(Jp, M, nb) + self.crit.payload
-            v_rel = max(0.0, float(nb @ (Jp @ qd)))
-        _, k, m_h = REGIONS[region]
-        force = peak_force(v_rel, m_r, m_h, k * 1000.0)
-        unsafe, reason = self.crit.judge(region, force, moving) if touching else (False, None)
-        return Contact(region, (float(n[0]), float(n[1]), float(n[2])), v_rel, m_r, m_h, k * 1000.0, force,
-                       transient_limit(region), touching, moving, unsafe, reason)
-
-    def first_unsafe(self, rows) -> int | None:
-        """Index of the first row that is unsafe under the criterion (contacts only: they are rare)."""
-        from cellstress.sim import kernels as K
-
-        tol = self.crit.distance_tolerance
-        for i in np.flatnonzero(rows[:, K.M_D] <= tol):
-            if self.assess(rows[i]).unsafe:
-                return int(i)
-        return None
+    def reward(self, horizon: int) -> IsoReward:
+        return IsoReward(horizon)
 
 
 class IsoReward:
@@ -281,8 +170,8 @@ class IsoReward:
         g = v_r / (v_r + self.V0) if v_r > 0.0 else 0.0
         return g * (1.0 + min(rho, 1.0)) / (1.0 + d_hr * d_hr)
 
-    def __call__(self, d_hr: float, v_r: float, rho: float, last_action: bool, unsafe: bool):
-        risk = self.risk(d_hr, v_r, rho, unsafe)
+    def __call__(self, measures: Measures, last_action: bool, unsafe: bool) -> tuple[float, float]:
+        risk = self.risk(measures.d_hr, measures.v_r, measures.severity, unsafe)
         if unsafe:
             return 2.0 * self.horizon, risk
         return (risk - 2.0 if last_action else risk), risk

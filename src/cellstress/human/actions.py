@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cellstress.errors import ActionError
+from cellstress.core.errors import ActionError
 
 WALKS: tuple[str, ...] = ("walk", "turn-left-45", "turn-left-90", "turn-right-45", "turn-right-90")
 BODIES: tuple[str, ...] = (

@@ -69,3 +69,19 @@ class BodyDimensions:
         p[B_BODY_RADIUS] = self.body_radius
         p[B_WALK_SPEED] = self.walking_speed
         return p
+
+
+@dataclass(frozen=True, eq=False)
+class BodyPose:
+    """The worker's capsules (``a``-``b`` axis, radius ``r``; order ``BODY_PARTS[:6]``: a[2] is the hip, a[3] the
+    head centre), shoulders (left, right) and trunk frame (columns: forward, left, up) for one pose."""
+
+    a: np.ndarray  # (6, 3)
+    b: np.ndarray  # (6, 3)
+    r: np.ndarray  # (6,)
+    shoulders: np.ndarray  # (2, 3)
+    trunk: np.ndarray  # (3, 3)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return BODY_PARTS[:N_CAPSULES]

@@ -15,12 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
+from cellstress.core import registry
 from cellstress.report import draw as D
 from cellstress.report import html as H
 
 REQUIRED = ("cell", "searcher", "seed", "budget", "found", "episodes")
-# fixed colours per searcher, so the same searcher looks the same in every panel and every campaign
-SEARCHER_COLORS = {"random": "#7f7f7f", "mcts": "#1f77b4", "mcts-commit": "#d62728"}
 _EXTRA_COLORS = ("#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf")
 
 
@@ -68,10 +67,17 @@ def discovery_curves(records: Iterable[Mapping]) -> dict[str, dict[str, np.ndarr
     return curves
 
 
+def searcher_colors() -> dict[str, str]:
+    """Each registered searcher's own colour (``Searcher.color``), so the same searcher looks the same in every
+    panel and every campaign; a searcher without one gets one of ``_EXTRA_COLORS`` by its place in the plot."""
+    return {name: cls.color for name, cls in registry.load_all("searchers").items() if getattr(cls, "color", None)}
+
+
 def _color(searcher: str, order: list[str]) -> str:
-    if searcher in SEARCHER_COLORS:
-        return SEARCHER_COLORS[searcher]
-    others = [s for s in order if s not in SEARCHER_COLORS]
+    fixed = searcher_colors()
+    if searcher in fixed:
+        return fixed[searcher]
+    others = [s for s in order if s not in fixed]
     return _EXTRA_COLORS[others.index(searcher) % len(_EXTRA_COLORS)]
 
 

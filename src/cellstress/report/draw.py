@@ -24,8 +24,6 @@ FLOOR = "#f7f7f7"
 FENCE = "#2b2b2b"
 TABLE = "#dcc9a0"
 TABLE_EDGE = "#8a7446"
-SCANNER = "#f2c300"
-CURTAIN = "#7b2cbf"
 SWEPT = "#f3c0bb"
 ROBOT = "#5a5a5a"
 ROBOT_HIT = "#d62728"
@@ -136,7 +134,7 @@ class PlanStyle:
 
 def swept_footprint(layout: Layout):
     """The floor area the robot sweeps over one cycle: the ISO 13855 check's hazard zone (same sampling)."""
-    from cellstress.cell.iso13855 import hazard_zone
+    from cellstress.analysis.iso13855 import hazard_zone
 
     return hazard_zone(layout)
 
@@ -164,17 +162,8 @@ def draw_plan(ax, layout: Layout, style: PlanStyle = PlanStyle(), robot_tau: flo
         for poly in spec.table.polygons:
             ax.add_patch(Polygon(poly, closed=True, fill=False, edgecolor=TABLE_EDGE, lw=0.8, ls=":", zorder=2.1))
         handles.append(Patch(facecolor=SWEPT, label="area the robot sweeps (one cycle)"))
-    for d in spec.devices:
-        if d.type == "laser-scanner":
-            ax.add_patch(Polygon(d.polygon, closed=True, facecolor=SCANNER, alpha=0.22, edgecolor="none", zorder=2.5))
-            ax.add_patch(Polygon(d.polygon, closed=True, fill=False, edgecolor=SCANNER, lw=1.5, ls="--", zorder=2.6))
-            handles.append(Patch(facecolor=SCANNER, alpha=0.4, edgecolor=SCANNER, ls="--",
-                                 label=f"scanner field '{d.name}' ({d.height:g} m, {d.response_time:g} s)"))
-        else:
-            (x0, y0), (x1, y1) = d.start, d.end
-            ax.plot([x0, x1], [y0, y1], color=CURTAIN, lw=5, solid_capstyle="butt", zorder=4.5)
-            handles.append(Line2D([], [], color=CURTAIN, lw=5, label=f"light curtain '{d.name}' "
-                                  f"({d.bottom:g}-{d.top:g} m, {d.response_time:g} s)"))
+    for d in spec.devices:  # each device kind draws itself (core.protocols.Device.draw)
+        handles.append(d.draw(ax))
     for f in spec.fences:
         xy = np.asarray(f.points, float)
         ax.plot(xy[:, 0], xy[:, 1], color=FENCE, lw=3.5, solid_capstyle="projecting", zorder=5)

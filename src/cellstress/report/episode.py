@@ -14,8 +14,9 @@ from functools import cached_property
 
 import numpy as np
 
+from cellstress.core.io import json_ready
 from cellstress.human.actions import ACTION_NAMES, action_index
-from cellstress.search.result import SearchResult, json_ready
+from cellstress.searchers.result import SearchResult
 from cellstress.sim import scene
 from cellstress.sim.build import Layout
 from cellstress.sim.simulator import Simulator
@@ -99,7 +100,7 @@ def replay(sim: Simulator, actions, *, episode: int | None = None, kind: str = "
            recorded: list[dict] | None = None) -> EpisodeView:
     """Play ``actions`` from the simulator's start and keep what a report needs. A leading ``start:NAME``
     (a cell with several start points) is played from that start, with its robot phase."""
-    from cellstress.search.multistart import split_start
+    from cellstress.sim.starts import split_start
 
     sim, actions = split_start(sim, actions)
     trace = sim.run(list(actions))

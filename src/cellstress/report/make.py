@@ -7,14 +7,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from cellstress.errors import CellstressError
+from cellstress.core.errors import CellstressError
 from cellstress.report import draw as D
 from cellstress.report import html as H
 from cellstress.report.animate import AnimationOptions, animate
 from cellstress.report.episode import EpisodeView, episode_of
 from cellstress.report.hazard import StillOptions, contact_figure, risk_figure, topview_figure
 from cellstress.report.story import Account, account
-from cellstress.search.result import FILE_NAME, SearchResult
+from cellstress.searchers.result import FILE_NAME, SearchResult
 
 NAMES = ("topview.png", "contact.png", "replay.gif", "risk.png", "report.html")
 
@@ -54,14 +54,12 @@ def _load(result: SearchResult | str | Path) -> tuple[SearchResult, Path | None]
 
 
 def _simulator(res: SearchResult, sim):
-    from cellstress.cell.load import load_cell
+    from cellstress.cell.load import load_cell, with_criterion
     from cellstress.sim.simulator import Simulator
 
     if sim is not None and sim.cell.sha256 == res.cell.get("sha256"):
         return sim
     try:
-        from cellstress.criteria import with_criterion
-
         return Simulator(with_criterion(load_cell(res.cell.get("source", res.cell["name"])),
                                         res.cell.get("criterion", "contact-while-moving")))
     except CellstressError as exc:

@@ -50,10 +50,11 @@ def _xy(r: dict) -> str:
 
 
 def _device_kind(view: EpisodeView, name: str) -> tuple[str, float]:
+    """(what the worker does when the device sees them, its response time) of the device named ``name``."""
     for d in view.layout.cell.spec.devices:
         if d.name == name:
-            return d.type, float(d.response_time)
-    return "device", math.nan
+            return d.detection_phrase, float(d.response_time)
+    return "is seen by the device", math.nan
 
 
 @dataclass(frozen=True)
@@ -103,8 +104,7 @@ def account(view: EpisodeView, episodes: int | None = None) -> Account:
         parts = []
         for name in r["devices"]:
             kind, resp = _device_kind(view, name)
-            verb = "walks into the field of the laser scanner" if kind == "laser-scanner" else \
-                "breaks the light curtain"
+            verb = kind
             parts.append(f"{verb} '{name}' (response {resp:g} s)")
         stop = stop_request(view, key)
         details.append(f"At t = {r['t']:.2f} s the worker {' and '.join(parts)} at {_xy(r)}; the stop takes "

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cellstress.errors import CellstressError
+from cellstress.core.errors import CellstressError
 
 # Short names for robots shipped by example-robot-data, resolved to files inside that package.
 BUILTIN_URDFS = {

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cellstress.cell.load import Cell
-from cellstress.devices import device_arrays, pack_polygons
+from cellstress.core.records import ScanPlane, VerticalField
 from cellstress.human.actions import action_table
 from cellstress.human.body import BodyDimensions
 from cellstress.human.reach import ReachField, reach_field
@@ -16,6 +16,52 @@ from cellstress.robot.capsules import Capsule, declared_capsule, fitted_capsules
 from cellstress.robot.model import RobotModel, load_robot, resolve_urdf
 from cellstress.robot.trajectory import Trajectory, build_trajectory
 from cellstress.sim import kernels as K
+
+SCANNER, CURTAIN = K.DEV_SCANNER, K.DEV_CURTAIN  # detection primitive kinds in the kernel
+
+
+@dataclass(frozen=True)
+class DeviceArrays:
+    kind: np.ndarray  # (nd,) int64
+    response: np.ndarray  # (nd,) s
+    rect: np.ndarray  # (nd, 6): vertical field x0 y0 x1 y1 bottom top; scan plane [4] = its height
+    poly: np.ndarray  # (nd, 2) int64: start and count of each scan plane's polygon in verts
+    verts: np.ndarray  # (V, 2)
+    names: tuple[str, ...]
+
+
+def pack_polygons(polys) -> tuple[np.ndarray, np.ndarray]:
+    """Concatenate polygons into one vertex array plus (start, count) rows."""
+    verts, index = [], []
+    for p in polys:
+        index.append((len(verts), len(p)))
+        verts.extend(p)
+    return np.asarray(verts, dtype=float).reshape(-1, 2), np.asarray(index, dtype=np.int64).reshape(-1, 2)
+
+
+def device_arrays(devices) -> DeviceArrays:
+    """The kernel's arrays of the cell's devices, from each device's detection primitive."""
+    kinds, resp, rects, polys = [], [], [], []
+    for d in devices:
+        prims = d.primitives()
+        if len(prims) != 1:
+            raise NotImplementedError(f"device {d.name!r}: the kernel takes one detection primitive per device")
+        prim = prims[0]
+        resp.append(d.response_time)
+        if isinstance(prim, ScanPlane):
+            kinds.append(SCANNER)
+            rects.append((0.0, 0.0, 0.0, 0.0, prim.height, prim.height))
+            polys.append(prim.polygon)
+        elif isinstance(prim, VerticalField):
+            kinds.append(CURTAIN)
+            rects.append((*prim.start, *prim.end, prim.bottom, prim.top))
+            polys.append(())
+        else:
+            raise TypeError(f"device {d.name!r}: unknown detection primitive {type(prim).__name__}")
+    verts, index = pack_polygons(polys)
+    return DeviceArrays(np.asarray(kinds, dtype=np.int64), np.asarray(resp, dtype=float),
+                        np.asarray(rects, dtype=float).reshape(-1, 6), index, verts,
+                        tuple(d.name for d in devices))
 
 
 @dataclass(frozen=True)
@@ -75,9 +121,10 @@ def build_layout(cell: Cell) -> Layout:
     scal[K.C_PHASE0] = task.phase
     scal[K.C_CYCLE] = traj.cycle
     scal[K.C_DWELL] = traj.dwell
-    scal[K.C_DTOL] = spec.criterion.distance_tolerance
-    # iso15066: the kernel latches no contact (it may be safe); the Simulator applies the force criterion
-    scal[K.C_VTOL] = spec.criterion.speed_tolerance if spec.criterion.type == "contact-while-moving" else np.inf
+    # a criterion without a kernel fast path: the kernel latches no contact (it may be safe), the Simulator judges
+    fast = spec.criterion.kernel_test()
+    scal[K.C_DTOL] = spec.criterion.distance_tolerance if fast is None else fast.distance_tolerance
+    scal[K.C_VTOL] = np.inf if fast is None else fast.speed_tolerance
     scal[K.C_REACH_ORIGIN] = reach.origin
     scal[K.C_REACH_H] = reach.spacing
 

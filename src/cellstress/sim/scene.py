@@ -7,31 +7,13 @@ so a picture shows exactly what the simulator measured. Nothing here is on the h
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from numba import njit
 
-from cellstress.human.body import BODY_PARTS, N_CAPSULES
+from cellstress.human.body import N_CAPSULES, BodyPose
 from cellstress.sim import kernels as K
 from cellstress.sim.build import Layout
 from cellstress.sim.geometry import segment_segment
-
-
-@dataclass(frozen=True, eq=False)
-class BodyPose:
-    """The worker's capsules (``a``-``b`` axis, radius ``r``; order ``BODY_PARTS[:6]``), shoulders (left, right)
-    and trunk frame (columns: forward, left, up) for one pose."""
-
-    a: np.ndarray  # (6, 3)
-    b: np.ndarray  # (6, 3)
-    r: np.ndarray  # (6,)
-    shoulders: np.ndarray  # (2, 3)
-    trunk: np.ndarray  # (3, 3)
-
-    @property
-    def names(self) -> tuple[str, ...]:
-        return BODY_PARTS[:N_CAPSULES]
 
 
 def body_pose(layout: Layout, x: float, y: float, heading: float, forward: float, lateral: float) -> BodyPose:

@@ -1,7 +1,13 @@
-"""The public simulator: reset, step, snapshot/restore, whole episodes and batches.
+"""The cell simulator: reset, step, snapshot/restore, whole episodes and batches.
 
-A state is a small float64 array (``NS`` entries): copying it is a snapshot. ``step`` never changes the
-state it is given, so a search tree can keep states in its nodes and branch from any of them.
+It is the ``core.protocols.Simulator`` that searchers see, with the optional abilities ``BatchSimulator``,
+``Lookahead``, ``CellRows`` and ``WorkerModel``. A state is a small float64 array (``NS`` entries): copying it
+is a snapshot. ``step`` never changes the state it is given, so a search tree can keep states in its nodes and
+branch from any of them.
+
+The criterion is the cell's (``cell.spec.criterion``). One with a kernel fast path (``kernel_test``) is
+evaluated inside the compiled loop; for any other, every contact of a step is handed to ``criterion.judge``
+(``sim.contacts``), and the first unsafe one ends the episode there, exactly as the kernel would.
 """
 
 from __future__ import annotations
@@ -12,10 +18,14 @@ from pathlib import Path
 import numpy as np
 
 from cellstress.cell.load import Cell, load_cell
+from cellstress.core.records import Measures
 from cellstress.human.actions import ACTION_NAMES, N_ACTIONS, action_index
 from cellstress.human.body import BODY_PARTS
 from cellstress.sim import kernels as K
-from cellstress.sim.build import Layout, build_layout
+from cellstress.sim.build import Layout, build_layout, with_phase
+from cellstress.sim.contacts import ContactModel
+from cellstress.sim.lookahead import Lookahead
+from cellstress.sim.starts import START_PREFIX, split_start
 
 STOP_PHASES = ("running", "stop-pending", "braking", "stopped")
 
@@ -71,18 +81,26 @@ def step_record(row: np.ndarray, layout: Layout) -> dict:
     }
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class BatchResult:
-    """Summary of many episodes: per action end d_HR / v_R (NaN after the episode ended unsafe)."""
+    """Summary of many episodes: per action end d_HR / v_R (NaN after the episode ended unsafe), the first unsafe
+    time step (-1: none), the least d_HR; for a criterion that judges contacts, its severity at each action end."""
 
     d_end: np.ndarray
     v_end: np.ndarray
     unsafe_step: np.ndarray
     min_d: np.ndarray
+    steps_per_action: int
+    severity_end: np.ndarray | None = None
 
     @property
     def unsafe(self) -> np.ndarray:
         return self.unsafe_step >= 0
+
+    @property
+    def played(self) -> np.ndarray:
+        """Actions played per episode: all of them, or up to the one that reached the unsafe set."""
+        return np.where(self.unsafe, -(-self.unsafe_step // self.steps_per_action), self.d_end.shape[1])
 
 
 class Simulator:
@@ -113,23 +131,17 @@ class Simulator:
                       self._s0, self._work, self._row0)
         self._s0.setflags(write=False)
         self._rows = np.zeros((self.params.spa, K.NM))
-        self.forces = _force_model(self.layout)
+        self.criterion = cell.spec.criterion
+        # a criterion without a kernel fast path judges the contacts here (sim.contacts)
+        self.contacts = None if self.criterion.kernel_test() is not None else ContactModel(self.layout)
         self._worker_w = None
-
-    @property
-    def criterion(self):
-        """The cell's criterion object (``ContactWhileMoving`` or ``Iso15066``)."""
-        from cellstress.criteria import criterion_for
-
-        return criterion_for(self.cell.spec.criterion)
+        self._lookahead: dict[tuple[float | None, float], Lookahead] = {}
 
     def with_start(self, start: tuple[float, float, float], phase: float | None = None) -> Simulator:
         """The same cell with another start pose (x, y, heading_deg) and, if ``phase`` is given, the robot's
         cycle at ``phase`` s when the episode starts; shares this simulator's set-up."""
         if phase is None:
             return Simulator(self.layout, start=start)
-        from cellstress.sim.build import with_phase
-
         return Simulator(with_phase(self.layout, phase), start=start)
 
     @property
@@ -172,8 +184,8 @@ class Simulator:
         nxt = state.copy()
         n = K.step_with_handle(self._handle, nxt, a, self._rows)
         rows = self._rows[:n].copy()
-        if self.forces is not None and n:
-            i = self.forces.first_unsafe(rows)
+        if self.contacts is not None and n:
+            i = self.first_unsafe(rows)
             if i is not None:  # the criterion's unsafe step ends the episode there, as the kernel's would
                 rows = rows[:i + 1]
                 rows[i, K.M_UNSAFE] = 1.0
@@ -181,6 +193,27 @@ class Simulator:
                 if i < n - 1:
                     _state_at(nxt, state, rows, self.params.dev_resp)
         return nxt, rows
+
+    def first_unsafe(self, rows: np.ndarray) -> int | None:
+        """Index of the first row the criterion judges unsafe (contacts only: they are rare)."""
+        tol = self.criterion.distance_tolerance
+        for i in np.flatnonzero(rows[:, K.M_D] <= tol):
+            if self.criterion.judge(self.contacts.contact(rows[i])).unsafe:
+                return int(i)
+        return None
+
+    def verdict(self, row: np.ndarray):
+        """The criterion's verdict on a row's closest points (``core.protocols.Verdict``), for a criterion that
+        judges contacts; None for one with a kernel fast path."""
+        return None if self.contacts is None else self.criterion.judge(self.contacts.contact(row))
+
+    def measures(self, rows: np.ndarray) -> Measures:
+        """What the reward sees of an action: d_HR and v_R at its last step (and the criterion's severity there)."""
+        last = rows[-1]
+        if self.contacts is None:
+            return Measures(float(last[K.M_D]), float(last[K.M_V]))
+        return Measures(float(last[K.M_D]), float(last[K.M_V]),
+                        float(self.criterion.severity(self.contacts.contact(last))))
 
     @staticmethod
     def is_unsafe(state: np.ndarray) -> bool:
@@ -198,24 +231,29 @@ class Simulator:
     def restore(snapshot: bytes) -> np.ndarray:
         return np.frombuffer(snapshot, dtype=np.float64).copy()
 
-    def lookahead(self, horizon: float | None = None, speed: float = 1.6):
+    def lookahead_model(self, horizon: float | None = None, speed: float = 1.6) -> Lookahead:
         """The predictive-gap score of this cell (``sim.lookahead.Lookahead``): how close the robot, moving on
         along its path for ``horizon`` seconds, comes to a worker's pose, less ``speed`` times the delay."""
-        from cellstress.sim.lookahead import Lookahead
-
         return Lookahead(self.params, horizon, speed)
+
+    def lookahead(self, state: np.ndarray, rows: np.ndarray, horizon: float | None = None,
+                  speed: float = 1.6) -> np.ndarray:
+        """The predictive gap of each of ``rows`` (``state``: the state after them); plays nothing."""
+        key = (horizon, speed)
+        la = self._lookahead.get(key)
+        if la is None:
+            la = self._lookahead[key] = self.lookahead_model(horizon, speed)
+        return la.gaps(rows, state[K.S_TSTOP])
 
     # ---- episodes ---------------------------------------------------------------------------------------
     def run(self, actions) -> Trace:
         """Play a whole action sequence from s0 (stopping at the first unsafe step). A leading ``start:NAME``
         plays it from that start point of the cell's ``human.starts`` (see ``search.multistart``)."""
-        if len(actions) and isinstance(actions[0], str) and actions[0].startswith("start:"):
-            from cellstress.search.multistart import split_start
-
+        if len(actions) and isinstance(actions[0], str) and actions[0].startswith(START_PREFIX):
             sim, rest = split_start(self, actions)
             return sim.run(rest)
         acts = np.asarray([action_index(a) for a in actions], dtype=np.int64)
-        if self.forces is not None:  # step by step, so that the criterion ends the episode
+        if self.contacts is not None:  # step by step, so that the criterion ends the episode
             state, parts = self.reset(), [self._row0[None, :].copy()]
             for a in acts:
                 state, rows = self.step(state, int(a))
@@ -235,22 +273,30 @@ class Simulator:
         v_end = np.empty((n_ep, n_act))
         unsafe_step = np.empty(n_ep, dtype=np.int64)
         min_d = np.empty(n_ep)
+        if self.contacts is not None:
+            return self._judged_batch(acts, d_end, v_end, unsafe_step, min_d)
         K.run_batch(self.params, self._s0, acts, d_end, v_end, unsafe_step, min_d)
-        if self.forces is not None:
-            # contacts are rare: replay the episodes that touched, one by one, with the force criterion
-            spa = self.params.spa
-            for e in np.flatnonzero(min_d <= self.forces.crit.distance_tolerance):
-                rows = self.run(acts[e]).rows
-                if rows[-1, K.M_UNSAFE] == 0.0:
-                    continue
-                last = int(rows[-1, K.M_STEP])
-                unsafe_step[e] = last
-                played = -(-last // spa)
-                d_end[e, played - 1], v_end[e, played - 1] = rows[-1, K.M_D], rows[-1, K.M_V]
-                d_end[e, played:] = np.nan
-                v_end[e, played:] = np.nan
-                min_d[e] = rows[1:, K.M_D].min()
-        return BatchResult(d_end, v_end, unsafe_step, min_d)
+        return BatchResult(d_end, v_end, unsafe_step, min_d, self.params.spa)
+
+    def _judged_batch(self, acts, d_end, v_end, unsafe_step, min_d) -> BatchResult:
+        """``run_batch`` for a criterion that judges contacts: each episode stepped (the criterion ends it at its
+        first unsafe contact), with the criterion's severity at every action end. The numbers are the kernel
+        batch's (the determinism check holds stepping and batches to the same bits)."""
+        severity = np.full(d_end.shape, np.nan)
+        d_end[:], v_end[:] = np.nan, np.nan
+        for e in range(len(acts)):
+            state, lo = self.reset(), np.inf
+            unsafe_step[e] = -1
+            for k, a in enumerate(acts[e]):
+                state, rows = self.step(state, int(a))
+                m = self.measures(rows)
+                d_end[e, k], v_end[e, k], severity[e, k] = m.d_hr, m.v_r, m.severity
+                lo = min(lo, float(rows[:, K.M_D].min()))
+                if self.is_unsafe(state):
+                    unsafe_step[e] = int(rows[-1, K.M_STEP])
+                    break
+            min_d[e] = lo
+        return BatchResult(d_end, v_end, unsafe_step, min_d, self.params.spa, severity)
 
     def worker_paths(self, actions: np.ndarray) -> np.ndarray:
         """The worker's poses (x, y, heading [rad], forward and lateral flexion [rad]) at every 50 ms step of
@@ -309,14 +355,3 @@ def _state_at(nxt: np.ndarray, before: np.ndarray, rows: np.ndarray, resp: np.nd
                 if nxt[K.S_TRIG_DEV] < 0:
                     nxt[K.S_TRIG_T] = t
                 nxt[K.S_TRIG_DEV] = d
-
-
-def _force_model(layout: Layout):
-    """The force model of an ``iso15066`` cell, else None (the kernel applies contact-while-moving itself)."""
-    spec = layout.cell.spec.criterion
-    if spec.type != "iso15066":
-        return None
-    from cellstress.criteria import criterion_for
-    from cellstress.criteria.iso15066 import ForceModel
-
-    return ForceModel(layout, criterion_for(spec))

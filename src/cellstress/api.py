@@ -1,0 +1,78 @@
+"""The Python API: plain functions with real signatures, for notebooks and scripts.
+
+    import cellstress
+    cell = cellstress.load_cell("s3-fence-gap")
+    verdict = cellstress.check(cell)                  # the static ISO 13855 / 13857 check
+    result = cellstress.search(cell, searcher="plan", budget=200, seed=0)
+    trace = cellstress.simulate(cell, ["walk+bend-right", "walk+bend-forward"])
+    cellstress.write_report(result, "out/s3")
+
+Each accepts what the command line accepts (a built-in cell name or a cell file's path, or a ``Cell``), raises
+``cellstress.core.errors.CellstressError`` for a user's mistake, and returns a typed record.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from cellstress.analysis.iso13855 import StaticCheck, check_cell
+from cellstress.cell import load
+from cellstress.cell.load import Cell
+from cellstress.report.make import ReportFiles
+from cellstress.report.make import write_report as _write_report
+from cellstress.searchers import DEFAULT_BUDGET, DEFAULT_TOP_K
+from cellstress.searchers import search as _search
+from cellstress.searchers.result import SearchResult
+from cellstress.sim.simulator import Simulator, Trace
+
+CellLike = Cell | str | Path
+
+
+def load_cell(path_or_name: str | Path) -> Cell:
+    """A built-in cell by name (``cellstress.BUILTIN_CELLS``) or a cell file by path, validated."""
+    return load.load_cell(path_or_name)
+
+
+def parse_cell(text: str, source: str = "<text>", directory: str | Path | None = None) -> Cell:
+    """A cell from the text of a cell file (YAML); ``source`` names it in error messages and ``directory`` is
+    where its relative paths (a URDF) are looked up."""
+    return load.parse_cell(text, source, None if directory is None else Path(directory))
+
+
+def _cell(cell: CellLike, criterion: str | None = None) -> Cell:
+    c = cell if isinstance(cell, Cell) else load.load_cell(cell)
+    return load.with_criterion(c, criterion)
+
+
+def check(cell: CellLike) -> StaticCheck:
+    """The static check of a cell: ISO 13855 distance of every device, the undetected reach around the fences.
+    ``.ok`` is the verdict, ``.failures()`` names what failed, ``.lines()`` is what ``cellstress check`` prints."""
+    return check_cell(_cell(cell))
+
+
+def search(cell: CellLike | Simulator, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int = 0, *,
+           until: str = "first", top_k: int = DEFAULT_TOP_K, distinct: bool = False, criterion: str | None = None,
+           progress: Callable[[int, float], None] | None = None, **options) -> SearchResult:
+    """Search a cell for a sequence of worker actions that ends in an unsafe state.
+
+    ``searcher``: a registered searcher (``random``, ``mcts``, ``mcts-commit``, ``evolve``, ``plan``, or a
+    plug-in's); ``options`` are its options (e.g. ``ec=0.5`` for ``mcts``). ``until="first"`` stops at the first
+    hazard, ``"budget"`` plays the whole budget; ``distinct=True`` (with ``until="budget"``) lists one hazard per
+    class. ``criterion`` overrides the cell's. The same arguments always give the same result."""
+    sim = cell if isinstance(cell, Simulator) and criterion is None else Simulator(_cell(
+        cell.cell if isinstance(cell, Simulator) else cell, criterion))
+    return _search(sim, searcher, budget, seed, until=until, top_k=top_k, progress=progress, distinct=distinct,
+                   **options)
+
+
+def simulate(cell: CellLike, actions: Sequence[int | str], criterion: str | None = None) -> Trace:
+    """Play ``actions`` (names such as ``"walk+bend-left"`` or indices 0..29) from the cell's start; the trace
+    has one row per 50 ms step, ``.unsafe`` and ``.records()``."""
+    return Simulator(_cell(cell, criterion)).run(list(actions))
+
+
+def write_report(result: SearchResult | str | Path, out: str | Path | None = None) -> ReportFiles:
+    """Write the report of a search result (pictures, animation, report.html) into ``out`` (default: the
+    result file's folder)."""
+    return _write_report(result, out)

@@ -1,0 +1,5 @@
+import sys
+
+from cellstress.cli import main
+
+sys.exit(main())

@@ -1,0 +1,28 @@
+"""``cellstress cells``: the built-in cells."""
+
+from __future__ import annotations
+
+import typer
+
+from cellstress.cli.common import first_sentence
+from cellstress.core.errors import CellstressError
+
+
+def cells() -> None:
+    """List the built-in cells with the first sentence of each description."""
+    import yaml
+
+    from cellstress.cell.load import BUILTIN_CELLS, builtin_text
+
+    width = max(len(n) for n in BUILTIN_CELLS)
+    for name in BUILTIN_CELLS:
+        try:
+            data = yaml.safe_load(builtin_text(name))
+        except CellstressError:
+            typer.echo(f"{name:<{width}}  (missing)")
+            continue
+        except yaml.YAMLError:
+            typer.echo(f"{name:<{width}}  (unreadable YAML: run 'cellstress check {name}')")
+            continue
+        description = data.get("description", "") if isinstance(data, dict) else ""
+        typer.echo(f"{name:<{width}}  {first_sentence(str(description or '')) or '(no description)'}")

@@ -1,0 +1,80 @@
+"""``cellstress check``: validate a cell file, summarise it and run the static ISO 13855 check."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+from cellstress.cli.common import CELL_HELP, first_sentence, num, user_errors
+
+
+def check(
+    cell: Annotated[str, typer.Argument(help=CELL_HELP)],
+) -> None:
+    """Validate a cell file and print a summary of it."""
+    import numpy as np
+
+    from cellstress.analysis.iso13855 import static_check
+    from cellstress.cell.load import BUILTIN_CELLS, load_cell
+    from cellstress.robot.capsules import declared_capsule, fitted_capsules
+    from cellstress.robot.model import load_robot, resolve_urdf
+    from cellstress.robot.trajectory import build_trajectory
+
+    with user_errors():
+        c = load_cell(cell)
+        spec = c.spec
+        urdf = resolve_urdf(spec.robot.urdf, c.directory)
+        robot = load_robot(urdf)
+        if spec.robot.capsules == "auto":
+            caps = list(fitted_capsules(robot))
+            cap_kind = "fitted to the collision meshes"
+        else:
+            caps = [declared_capsule(robot, k.link, k.link, k.p0, k.p1, k.radius)
+                    for k in spec.robot.capsules]
+            cap_kind = "declared"
+        n_own = len(caps)
+        for i, k in enumerate(spec.robot.extra_capsules):
+            caps.append(declared_capsule(robot, f"{k.link}#extra{i}", k.link, k.p0, k.p1, k.radius))
+        task = spec.robot.task
+        traj = build_trajectory(task.waypoints_deg, task.dwell, task.speed_scale, robot.velocity_limits)
+        static = static_check(c)
+
+    out = typer.echo
+    origin = "built-in" if cell in BUILTIN_CELLS else "file"
+    out(f"cell        {spec.name}  ({origin}: {c.source}, sha256 {c.sha256[:12]})")
+    if spec.description:
+        out(f"            {first_sentence(spec.description)}")
+    base = spec.robot.base
+    out(f"robot       {spec.robot.urdf} -> {urdf}")
+    out(f"            {robot.n_joints} joints, base at ({', '.join(num(v) for v in base.xyz)}) "
+        f"yaw {num(base.yaw_deg)} deg, stopping time {num(spec.robot.stopping_time)} s")
+    extra = f" + {len(caps) - n_own} extra" if len(caps) > n_own else ""
+    out(f"capsules    {len(caps)} ({n_own} {cap_kind}{extra})")
+    for k in caps:
+        length = float(np.linalg.norm(np.subtract(k.p1, k.p0)))
+        out(f"            {k.name:<18} on joint {k.joint:>2}  radius {k.radius:.3f} m  length {length:.3f} m")
+    out(f"task        {len(task.waypoints_deg)} waypoints, dwell {num(task.dwell)} s, speed scale "
+        f"{num(task.speed_scale)}, phase {num(task.phase)} s, cycle time {traj.cycle:.2f} s")
+    out(f"table       {len(spec.table.polygons)} polygon(s), height {num(spec.table.height)} m")
+    panels = sum(len(f.points) - 1 for f in spec.fences)
+    out(f"fences      {len(spec.fences)} ({panels} straight segments)")
+    fl = spec.floor
+    out(f"floor       x {num(fl.xmin)}..{num(fl.xmax)} m, y {num(fl.ymin)}..{num(fl.ymax)} m")
+    out(f"devices     {len(spec.devices)}")
+    for d in spec.devices:
+        out(f"            {d.name:<18} {d.type:<14} response {num(d.response_time)} s  {d.describe()}")
+    h = spec.human
+    x, y = h.start.xy
+    out(f"human       start ({num(x)}, {num(y)}) heading {num(h.start.heading_deg)} deg, "
+        f"height {num(h.anthropometry.height)} m, walking {num(h.walking_speed)} m/s")
+    cr = spec.criterion
+    out(f"criterion   {cr.type} (distance tolerance {num(cr.distance_tolerance)} m, "
+        f"speed tolerance {num(cr.speed_tolerance)} m/s)")
+    sim = spec.simulation
+    out(f"simulation  dt {num(sim.dt)} s, {sim.steps_per_action} steps per action, "
+        f"{sim.actions_per_episode} actions per episode")
+    out("ISO 13855 static check:")
+    for line in static:
+        out(f"  {line}")
+    out("valid")

@@ -1,0 +1,89 @@
+"""Shared helpers of the command modules: one-line errors, the --out folder check, number and step formatting.
+
+User errors (a bad cell file, an unknown action, a bad option) end the program with exit code 2 and one line
+``error: <message>`` on stderr. Command modules import only typer and this module at the top, and the heavy
+parts (pydantic, pinocchio, numba) inside their commands, so that ``cellstress --help`` starts fast.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import typer
+
+from cellstress.core.errors import CellstressError
+
+USER_ERROR = 2
+CELL_HELP = "A built-in cell name (see 'cellstress cells') or the path of a cell file."
+
+
+def fail(message: str) -> typer.Exit:
+    """Print ``error: message`` as one line on stderr; the caller raises the returned Exit(2)."""
+    one_line = " ".join(str(message).split())
+    typer.echo(f"error: {one_line}", err=True)
+    return typer.Exit(USER_ERROR)
+
+
+@contextmanager
+def user_errors(prefix: str = "") -> Iterator[None]:
+    try:
+        yield
+    except CellstressError as exc:
+        raise fail(prefix + str(exc)) from None
+
+
+def num(x: float) -> str:
+    """A short, exact-looking number: 1.25, 0.05, 12 (no float noise such as 1.2500000000000002)."""
+    return f"{round(float(x), 6):g}"
+
+
+def first_sentence(text: str) -> str:
+    text = " ".join(text.split())
+    match = re.search(r"(?<=[.!?])\s", text)
+    return text[: match.start()] if match else text
+
+
+def check_out_dir(out: str) -> Path:
+    """The --out folder, created if needed; exit 2 when it cannot be written."""
+    path = Path(out).expanduser()
+    try:
+        if path.exists() and not path.is_dir():
+            raise fail(f"--out {out}: exists and is not a directory")
+        path.mkdir(parents=True, exist_ok=True)
+        fd, probe = tempfile.mkstemp(prefix=".write-test-", dir=path)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise fail(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
+    return path
+
+
+HEADER = (f"{'step':>4} {'t[s]':>6} {'x[m]':>7} {'y[m]':>7} {'head[deg]':>9} {'fwd[deg]':>8} "
+          f"{'lat[deg]':>8} {'d_HR[m]':>8} {'v_R[m/s]':>8}  {'phase':<12} {'action':<26} devices")
+
+
+def step_line(r: dict) -> str:
+    devices = ",".join(r["devices"]) or "-"
+    return (f"{r['step']:>4} {r['t']:>6.2f} {r['x']:>7.3f} {r['y']:>7.3f} {r['heading_deg']:>9.1f} "
+            f"{r['forward_flexion_deg']:>8.1f} {r['lateral_flexion_deg']:>8.1f} {r['d_HR']:>8.3f} "
+            f"{r['v_R']:>8.3f}  {r['stop_phase']:<12} {r['action'] or '-':<26} {devices}")
+
+
+def check_criterion(name: str | None) -> None:
+    """CellstressError unless ``name`` is None or a registered criterion."""
+    from cellstress.cell.schema import CRITERIA
+
+    if name is not None and name not in CRITERIA:
+        raise CellstressError(f"--criterion: unknown criterion {name!r} (choose from {', '.join(CRITERIA)})")
+
+
+def criterion_help(what: str) -> str:
+    """The --criterion option's help, naming the registered criteria."""
+    from cellstress.core import registry
+
+    return f"{' or '.join(registry.names('criteria'))}; default: {what}."

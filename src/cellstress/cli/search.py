@@ -1,0 +1,137 @@
+"""``cellstress search``: run one searcher on a cell, write result.json and its report."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+from cellstress.cli.common import CELL_HELP, check_criterion, check_out_dir, criterion_help, fail, num, user_errors
+from cellstress.core.errors import CellstressError
+
+
+def _searcher_help() -> str:
+    from cellstress.core import registry
+
+    return (f"One of {', '.join(registry.names('searchers'))} (mcts is the paper's MCTS1, mcts-commit its MCTS2; "
+            "evolve and plan are ours; see docs/results.md).")
+
+
+def _params_text(params: dict) -> str:
+    return ", ".join(f"{k} {'auto' if v is None else num(v) if isinstance(v, float) else v}"
+                     for k, v in params.items())
+
+
+def search(
+    cell: Annotated[str, typer.Argument(help=CELL_HELP)],
+    out: Annotated[str, typer.Option("--out", "-o", help="Folder for result.json (created if needed).")],
+    searcher: Annotated[str, typer.Option("--searcher", "-s", help=_searcher_help())] = "mcts",
+    budget: Annotated[int, typer.Option("--budget", "-b", help="Episodes (one iteration = one episode of "
+                                        "up to 8 actions from s0).")] = 200,
+    seed: Annotated[int, typer.Option("--seed", help="Seed (>= 0) of numpy's SeedSequence.")] = 0,
+    until: Annotated[str, typer.Option("--until", help="first: stop at the first unsafe state; budget: play "
+                                       "the whole budget and record every hazardous episode.")] = "first",
+    top_k: Annotated[int, typer.Option("--top-k", help="How many of the best episodes to keep.")] = 10,
+    ec: Annotated[float | None, typer.Option("--ec", help="MCTS exploration constant (default 0.5; "
+                                        "returns here differ by about 1 between good and bad prefixes).")] = None,
+    k: Annotated[float | None, typer.Option("--k", help="MCTS widening factor k: a node tries a "
+                                      "new action while children <= k N^alpha (default 1.0).")] = None,
+    alpha: Annotated[float | None, typer.Option("--alpha", help="MCTS widening exponent (default 0.85).")] \
+        = None,
+    n: Annotated[int | None, typer.Option("--n", help="mcts-commit: iterations per decision "
+                                          "(default budget // 8).")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print result.json to stdout instead of the "
+                                          "summary.")] = False,
+    no_report: Annotated[bool, typer.Option("--no-report", help="Do not write the report (pictures, "
+                                            "report.html) next to result.json.")] = False,
+    criterion: Annotated[str | None, typer.Option("--criterion", help=criterion_help("the cell file's"))] = None,
+    distinct: Annotated[bool, typer.Option("--distinct", help="With --until budget: cluster the hazards "
+                                           "into classes, steer away from classes found, list each (evolve, "
+                                           "plan: the budget shared between the start points in slices).")] = False,
+    settings: Annotated[list[str] | None, typer.Option("--set", help="Any other option of the searcher, "
+                                                       "NAME=VALUE, repeated (e.g. --set pool=5 --set "
+                                                       "score=risk for evolve; its docstring lists them).")] = None,
+) -> None:
+    """Search a cell for a sequence of worker actions that ends in an unsafe contact; write result.json
+    and its report (see 'cellstress report')."""
+    import time
+
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from cellstress.cell.load import load_cell, with_criterion
+    from cellstress.cli.report import after_search
+    from cellstress.searchers import make_searcher, parse_options
+    from cellstress.searchers import search as run
+    from cellstress.searchers.common import check_common
+    from cellstress.sim.simulator import Simulator
+
+    options = {name: v for name, v in (("ec", ec), ("k", k), ("alpha", alpha), ("n", n)) if v is not None}
+    with user_errors():
+        extra = parse_options(settings)
+        twice = sorted(set(extra) & set(options))
+        if twice:
+            raise CellstressError(f"--set {twice[0]}: given as --{twice[0]} too")
+        options.update(extra)
+        check_common(budget, seed, until, top_k)
+        make_searcher(searcher, **options)
+        check_criterion(criterion)
+        if distinct and until != "budget":
+            raise CellstressError("--distinct needs --until budget")
+    out_dir = check_out_dir(out)
+    with user_errors():
+        sim = Simulator(with_criterion(load_cell(cell), criterion))
+
+    console = Console(stderr=True)
+    progress = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+                        TextColumn("{task.fields[rate]:>7.0f} episodes/s  best risk {task.fields[risk]:.3f}"),
+                        TimeElapsedColumn(), console=console, transient=True,
+                        disable=not console.is_terminal)
+    task = progress.add_task(searcher, total=budget, rate=0.0, risk=0.0)
+    t0 = time.perf_counter()
+
+    def tick(done: int, best_risk: float) -> None:
+        if done % 8 == 0 or done == budget:
+            progress.update(task, completed=done, rate=done / max(time.perf_counter() - t0, 1e-9), risk=best_risk)
+
+    with progress, user_errors():
+        result = run(sim, searcher, budget, seed, until=until, top_k=top_k, progress=tick, distinct=distinct,
+                     **options)
+    elapsed = time.perf_counter() - t0
+    try:
+        path = result.write(out_dir)
+    except OSError as exc:
+        raise fail(f"--out {out}: cannot write result.json ({exc.strerror or exc})") from None
+    rate = result.episodes / max(elapsed, 1e-9)
+    report = None if no_report else after_search(path, sim)
+    if as_json:
+        typer.echo(result.to_json(), nl=False)
+        if report:
+            typer.echo(report, err=True)
+        typer.echo(f"{result.episodes} episodes in {elapsed:.2f} s ({rate:.0f} episodes/s); wrote {path}",
+                   err=True)
+        return
+    echo = typer.echo
+    echo(f"cell      {result.cell['name']}  searcher {result.searcher} ({_params_text(result.params)})  "
+         f"seed {seed}  budget {budget}")
+    best = max(result.risk_per_episode, default=0.0)
+    h = result.hazard
+    if h is None:
+        echo(f"no hazard in {result.episodes} episodes (best risk {best:.3f}; {elapsed:.2f} s, "
+             f"{rate:.0f} episodes/s)")
+    else:
+        extra_text = f", {len(result.hazards)} hazardous episodes in all" if until == "budget" else ""
+        echo(f"FOUND at episode {h['episode']} of {budget}{extra_text} ({result.episodes} episodes in "
+             f"{elapsed:.2f} s, {rate:.0f} episodes/s)")
+        echo(f"actions   {', '.join(h['actions'])}")
+        x, y, z = h["point"]
+        echo(f"contact   t={num(h['time_s'])} s (step {h['step']}): {h['robot_link']} / {h['body_part']} at "
+             f"({x:.3f}, {y:.3f}, {z:.3f}) m, robot moving at v_R {h['v_R']:.3f} m/s")
+    for i, d in enumerate(result.distinct or []):
+        cls = d["class"]
+        x0, y0, x1, y1 = cls["approach_cell"]
+        echo(f"class {i}   episode {d['episode']}: {cls['device']} / {cls['robot_link']} / {cls['body_region']} at "
+             f"x {num(x0)}..{num(x1)}, y {num(y0)}..{num(y1)}  (cellstress replay {path} --hazard {i})")
+    if report:
+        echo(report)
+    echo(f"wrote     {path}")

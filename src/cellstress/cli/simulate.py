@@ -1,0 +1,60 @@
+"""``cellstress simulate``: play one action sequence and print every 50 ms step."""
+
+from __future__ import annotations
+
+import json
+from typing import Annotated
+
+import typer
+
+from cellstress.cli.common import CELL_HELP, HEADER, check_criterion, criterion_help, num, step_line, user_errors
+
+
+def simulate(
+    cell: Annotated[str, typer.Argument(help=CELL_HELP)],
+    actions: Annotated[str, typer.Option("--actions", "-a", help="Comma-separated actions, e.g. "
+                                         "walk+upright,turn-left-45+bend-forward (WALK+BODY).")],
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON document instead of the table.")] \
+        = False,
+    criterion: Annotated[str | None, typer.Option("--criterion", help=criterion_help("the cell file's"))] = None,
+) -> None:
+    """Play a sequence of worker actions in a cell and report whether it ends in an unsafe contact."""
+    from cellstress.cell.load import load_cell, with_criterion
+    from cellstress.core.io import json_ready
+    from cellstress.human.actions import ACTION_NAMES, parse_actions
+    from cellstress.sim.simulator import Simulator
+
+    with user_errors("--actions: "):
+        indices = parse_actions(actions)
+    with user_errors():
+        check_criterion(criterion)
+        c = with_criterion(load_cell(cell), criterion)
+        sim = Simulator(c)
+        trace = sim.run(indices)
+    records = trace.records()
+    hit = trace.unsafe_row
+    hazard = None
+    verdict = None
+    if hit is not None:
+        r = records[hit]
+        hazard = {k: r[k] for k in ("t", "step", "robot_link", "body_part", "robot_point", "human_point",
+                                    "d_HR", "v_R")}
+        verdict = sim.verdict(trace.rows[hit])
+        if verdict is not None:  # a criterion that judges contacts: its account of this one
+            hazard[sim.criterion.type] = verdict.as_dict()
+
+    if as_json:
+        doc = {"cell": c.name, "actions": [ACTION_NAMES[i] for i in indices], "steps": records,
+               "unsafe": hazard is not None, "hazard": hazard}
+        typer.echo(json.dumps(json_ready(doc), indent=1, allow_nan=False))
+        return
+    typer.echo(HEADER)
+    for r in records:
+        typer.echo(step_line(r))
+    if hazard is None:
+        typer.echo("SAFE")
+    else:
+        typer.echo(f"UNSAFE at t={num(hazard['t'])} s (step {hazard['step']}): "
+                   f"{hazard['robot_link']} / {hazard['body_part']}")
+        if verdict is not None:
+            typer.echo(f"{sim.criterion.type}  {verdict.reason}")

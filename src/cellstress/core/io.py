@@ -1,0 +1,126 @@
+"""Files in and out: canonical JSON, atomic writes, and reading files that other people send.
+
+Every output is written atomically (a temporary file in the same folder, then ``os.replace``): a crash leaves
+the old file or the new one, never a mix, and a symbolic link planted at the target is replaced, not followed.
+Inputs (cell files, result files) are untrusted: only regular files are read, and never more than
+``MAX_INPUT_BYTES``, so a FIFO, a device or a huge file gives one clear error instead of a hang.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import stat
+import tempfile
+from pathlib import Path
+from typing import Any
+
+MAX_INPUT_BYTES = 10 * 1024 * 1024  # no cell or result file of ours comes near this (a result is ~1 MB)
+
+
+class InputFileError(Exception):
+    """A file that cannot be read as input: ``problem`` says why in a few words (the caller names the file)."""
+
+    def __init__(self, problem: str):
+        self.problem = problem
+        super().__init__(problem)
+
+
+def json_ready(obj: Any) -> Any:
+    """Plain JSON values: non-finite floats -> null, tuples -> lists, numpy scalars -> Python numbers."""
+    if isinstance(obj, bool) or obj is None or isinstance(obj, str):
+        return obj
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, int):
+        return int(obj)
+    if isinstance(obj, dict):
+        return {str(k): json_ready(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_ready(v) for v in obj]
+    if hasattr(obj, "item"):  # numpy scalar
+        return json_ready(obj.item())
+    raise TypeError(f"not JSON-ready: {type(obj).__name__}")
+
+
+def canonical_json(doc: Any) -> str:
+    """``doc`` as the text our JSON files hold: sorted keys, one-space indent, no NaN, a final newline.
+
+    Floats use Python's shortest round-trip repr, so the same values always give the same bytes."""
+    return json.dumps(json_ready(doc), sort_keys=True, indent=1, allow_nan=False) + "\n"
+
+
+def json_line(record: Any) -> str:
+    """A record as one line of text (no newline): sorted keys, no spaces, no NaN."""
+    return json.dumps(json_ready(record), sort_keys=True, separators=(",", ":"), allow_nan=False)
+
+
+def atomic_write(path: Path, data: bytes) -> None:
+    """Replace ``path`` by ``data`` atomically (a crash leaves the old or the new file, never a mix).
+
+    The new file gets the permissions a plain ``open`` would give it (0666 less the umask)."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}-", suffix=".tmp", dir=path.parent)
+    try:
+        os.fchmod(fd, 0o666 & ~_umask())
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    atomic_write(path, text.encode("utf-8"))
+
+
+def _umask() -> int:
+    # os.umask can only be read by setting it; set it back at once (a process-wide value, read here only)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def read_input_bytes(path: str | Path, max_bytes: int = MAX_INPUT_BYTES) -> bytes:
+    """The bytes of a regular file of at most ``max_bytes``; InputFileError (a short reason) otherwise.
+
+    The file is opened without blocking and checked with fstat before anything is read, so a FIFO or a
+    device never blocks and nothing beyond the cap is ever read."""
+    p = Path(path).expanduser()
+    try:
+        fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))
+    except FileNotFoundError:
+        raise InputFileError("no such file") from None
+    except IsADirectoryError:
+        raise InputFileError("is a directory, not a file") from None
+    except OSError as exc:
+        raise InputFileError(f"cannot be read: {exc.strerror or exc}") from None
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            raise InputFileError("is a directory, not a file")
+        if not stat.S_ISREG(st.st_mode):
+            raise InputFileError("is not a regular file (a pipe, a device or a socket)")
+        if st.st_size > max_bytes:
+            raise InputFileError(f"is too large ({st.st_size:,} bytes; at most {max_bytes:,})")
+        chunks, total = [], 0
+        while True:
+            chunk = os.read(fd, min(1 << 20, max_bytes + 1 - total))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            total += len(chunk)
+            if total > max_bytes:  # it grew while we read it
+                raise InputFileError(f"is too large (more than {max_bytes:,} bytes)")
+        return b"".join(chunks)
+    except OSError as exc:
+        raise InputFileError(f"cannot be read: {exc.strerror or exc}") from None
+    finally:
+        os.close(fd)

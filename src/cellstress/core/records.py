@@ -1,0 +1,91 @@
+"""Small typed, immutable records that cross layers: what a reward sees, what a criterion judges, what a
+device gives the kernel, and what an ISO 13855 distance is.
+
+They hold numbers and names only (no arrays that change, no behaviour), so they pickle, compare and print.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import NamedTuple
+
+Point2 = tuple[float, float]
+Point3 = tuple[float, float, float]
+
+
+class Measures(NamedTuple):
+    """What a reward sees at the end of one action (a NamedTuple: it is made after every simulated action)."""
+
+    d_hr: float  # human-robot distance [m]; 0 when the robot is within the worker's reach
+    v_r: float  # Cartesian speed of the robot's fastest joint [m/s]
+    # the criterion's severity of a contact at the closest points now (iso15066: predicted force / transient
+    # limit, as if they touched); None for criteria that judge by distance and speed alone
+    severity: float | None = None
+    # distinct mode: the unsafe state repeats a hazard class already found (a reward may pay it as a safe end)
+    repeat: bool = False
+
+
+class KernelTest(NamedTuple):
+    """A criterion's fast path: unsafe exactly when d_HR <= distance_tolerance and v_R > speed_tolerance,
+    evaluated inside the compiled simulation loop."""
+
+    distance_tolerance: float
+    speed_tolerance: float
+
+
+@dataclass(frozen=True)
+class Contact:
+    """The simulator's account of the closest point pair between worker and robot at one time step, for
+    criteria that judge contacts themselves (``Criterion.judge``).
+
+    Points are in the cell frame [m]; ``normal`` is the unit vector from the robot point towards the human
+    point; ``v_rel`` [m/s] is the robot point's speed along it (towards the human, never below 0);
+    ``reflected_mass`` [kg] is the robot's inertia felt at that point along the normal (inf when its joints
+    cannot move the point that way), without any payload.
+    """
+
+    d_hr: float
+    v_r: float
+    robot_link: str
+    body_part: str
+    region: str  # ISO/TS 15066 body region of the human point (``human.regions``)
+    robot_point: Point3
+    human_point: Point3
+    normal: Point3
+    v_rel: float
+    reflected_mass: float
+
+
+# ---- detection primitives: what a safety device gives the compiled kernel ------------------------------------
+@dataclass(frozen=True)
+class ScanPlane:
+    """A horizontal detection plane at ``height`` [m] inside a polygon (a laser scanner's field, a mat's
+    area): it sees a body capsule that crosses the plane inside the polygon."""
+
+    polygon: tuple[Point2, ...]
+    height: float
+
+
+@dataclass(frozen=True)
+class VerticalField:
+    """A vertical detection rectangle over the floor segment ``start``-``end`` from ``bottom`` to ``top`` [m]
+    (a light curtain, a door's opening): it sees a body capsule that touches the rectangle."""
+
+    start: Point2
+    end: Point2
+    bottom: float
+    top: float
+
+
+Primitive = ScanPlane | VerticalField
+
+
+@dataclass(frozen=True)
+class IsoDistance:
+    """One ISO 13855 minimum distance S = K T + C: K [mm/s], T [s], C and S [mm], and the arithmetic as text."""
+
+    K: float
+    T: float
+    C: float
+    S: float
+    formula: str

@@ -1,0 +1,17 @@
+"""What every safety device record has: a name, a response time, and the record conventions of cell files."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from pydantic import Field
+
+from cellstress.core.fields import PositiveTime, Record
+
+
+class DeviceRecord(Record):
+    """The fields every device kind shares. A device kind is a subclass with a ``type: Literal[...]`` tag (its
+    name in cell files and in the ``cellstress.devices`` registry) and the ``core.protocols.Device`` methods."""
+
+    name: Annotated[str, Field(min_length=1)]
+    response_time: PositiveTime

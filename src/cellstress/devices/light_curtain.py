@@ -1,0 +1,90 @@
+"""A vertical light curtain across an opening: a rectangle over a floor segment.
+
+It sees any body capsule that touches its rectangle. Our worker model's devices never see an outstretched arm
+(docs/architecture.md), so every curtain acts as a body detector: the distance required is ISO 13855's
+S = 1600 mm/s * T + 850 mm, or the nominal value for its resolution d if that is larger (d <= 40 mm:
+S = 2000 T + 8 (d - 14), and above 500 mm S = 1600 T + 8 (d - 14), at least 500 mm).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, ClassVar, Literal
+
+from pydantic import Field, model_validator
+
+from cellstress.core.fields import Length, NonNegative, Point2, PositiveTime
+from cellstress.core.iso13855 import K_HAND, K_WALK, MIN_C_BODY, mm
+from cellstress.core.records import IsoDistance, VerticalField
+from cellstress.devices.base import DeviceRecord
+
+
+def nominal_distance(T: float, resolution_mm: float) -> IsoDistance:
+    """ISO 13855:2010, detection zone orthogonal to the approach (vertical field), detection capability d."""
+    d = resolution_mm
+    if d <= 40.0:
+        c = 8.0 * (d - 14.0)
+        s = K_HAND * T + c
+        text = f"S = 2000*{T:.2f} + 8*({mm(d)} - 14) = {mm(s)} mm"
+        if s < 100.0:
+            return IsoDistance(K_HAND, T, c, 100.0, text + " < 100, so 100 mm")
+        if s <= 500.0:
+            return IsoDistance(K_HAND, T, c, s, text)
+        s2 = K_WALK * T + c
+        text += f" > 500, so 1600*{T:.2f} + {mm(c)} = {mm(s2)} mm"
+        if s2 < 500.0:
+            return IsoDistance(K_WALK, T, c, 500.0, text + " -> minimum 500 mm")
+        return IsoDistance(K_WALK, T, c, s2, text)
+    s = K_WALK * T + MIN_C_BODY
+    return IsoDistance(K_WALK, T, MIN_C_BODY, s, f"S = 1600*{T:.2f} + 850 = {mm(s)} mm (d > 40 mm)")
+
+
+class LightCurtain(DeviceRecord):
+    """``start``-``end``: the curtain's line on the floor [m]; beams from ``bottom`` to ``top`` [m];
+    ``resolution_mm``: detection capability d; ``response_time`` [s]."""
+
+    type: Literal["light-curtain"]
+    start: Point2
+    end: Point2
+    bottom: NonNegative = 0.2
+    top: Length = 1.8
+    response_time: PositiveTime = 0.05
+    resolution_mm: Annotated[float, Field(gt=0.0, le=200.0)] = 30.0
+
+    detection_phrase: ClassVar[str] = "breaks the light curtain"
+    color: ClassVar[str] = "#7b2cbf"
+
+    @model_validator(mode="after")
+    def _shape(self) -> LightCurtain:
+        if self.start == self.end:
+            raise ValueError("start and end are the same point")
+        if self.top <= self.bottom:
+            raise ValueError(f"top ({self.top}) must be above bottom ({self.bottom})")
+        return self
+
+    def primitives(self) -> tuple[VerticalField, ...]:
+        return (VerticalField(tuple(self.start), tuple(self.end), self.bottom, self.top),)
+
+    def nominal_distance(self, stopping_time: float) -> IsoDistance:
+        return nominal_distance(self.response_time + stopping_time, self.resolution_mm)
+
+    def required_distance(self, stopping_time: float) -> IsoDistance:
+        T = self.response_time + stopping_time
+        nominal = nominal_distance(T, self.resolution_mm)
+        s = K_WALK * T + MIN_C_BODY
+        if nominal.S > s:
+            return nominal
+        return IsoDistance(K_WALK, T, MIN_C_BODY, s, f"ISO for d = {nominal.formula}; body-only sensing: "
+                                                     f"S = 1600*{T:.2f} + 850 = {mm(s)} mm")
+
+    def describe(self) -> str:
+        (x0, y0), (x1, y1) = self.start, self.end
+        return (f"({x0:g}, {y0:g})-({x1:g}, {y1:g}), {self.bottom:g}..{self.top:g} m, "
+                f"{self.resolution_mm:g} mm")
+
+    def draw(self, ax):
+        from matplotlib.lines import Line2D
+
+        (x0, y0), (x1, y1) = self.start, self.end
+        ax.plot([x0, x1], [y0, y1], color=self.color, lw=5, solid_capstyle="butt", zorder=4.5)
+        return Line2D([], [], color=self.color, lw=5, label=f"light curtain '{self.name}' "
+                      f"({self.bottom:g}-{self.top:g} m, {self.response_time:g} s)")

@@ -1,0 +1,207 @@
+"""Search for hazards: ``random``, ``mcts`` (the paper's MCTS1), ``mcts-commit`` (MCTS2), and ours: ``evolve``
+and ``plan``; any other searcher registered in the ``cellstress.searchers`` entry-point group.
+
+One module per searcher over shared machinery (``common``: budget, top-k, records, rollouts; ``tree``: the DPW
+tree; ``result``: the result record); the distinct and multi-start modes apart (``distinct``, ``multistart``,
+``slices``). ``search`` is the public entry point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, fields
+from pathlib import Path
+
+from cellstress.core import registry
+from cellstress.core.errors import PluginError
+from cellstress.core.version import __version__
+from cellstress.human.actions import ACTION_NAMES
+from cellstress.searchers.common import (
+    UNTIL,
+    Episode,
+    Outcome,
+    Recorder,
+    SearchError,
+    Stop,
+    check_common,
+)
+from cellstress.searchers.distinct import DistinctRecorder, DistinctReward, class_dict, distinct_problem
+from cellstress.searchers.multistart import MultiStartProblem
+from cellstress.searchers.result import SearchResult
+from cellstress.searchers.slices import ClassRecorder, cell_starts, run_slices
+from cellstress.sim.simulator import Simulator
+
+DEFAULT_BUDGET = 200
+DEFAULT_TOP_K = 10
+
+__all__ = ["UNTIL", "Episode", "Outcome", "Recorder", "SearchError", "SearchResult", "make_searcher",
+           "parse_options", "run_search", "search", "searcher_class", "searcher_names"]
+
+
+def searcher_names() -> tuple[str, ...]:
+    """The registered searchers (``cellstress.searchers`` entry points), cellstress's own first."""
+    return registry.names("searchers")
+
+
+def searcher_class(name: str):
+    """The class registered as searcher ``name``; SearchError naming the choices for an unknown name."""
+    try:
+        return registry.load("searchers", name)
+    except PluginError as exc:
+        raise SearchError(str(exc)) from None
+
+
+def parse_options(settings: list[str] | tuple[str, ...] | None, flag: str = "--set") -> dict:
+    """``["pool=5", "score=risk"]`` -> ``{"pool": 5, "score": "risk"}``: each VALUE is read as JSON (numbers,
+    true/false, null, quoted strings), else taken as plain text. SearchError for a malformed or repeated one."""
+    import json
+
+    out: dict = {}
+    for item in settings or ():
+        name, sep, text = str(item).partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise SearchError(f"{flag} {item!r}: expected NAME=VALUE (e.g. {flag} pool=5)")
+        if name in out:
+            raise SearchError(f"{flag}: option {name!r} given twice")
+        try:
+            out[name] = json.loads(text)
+        except ValueError:
+            out[name] = text.strip()
+    return out
+
+
+def make_searcher(name: str, **options):
+    """The searcher ``name`` with ``options``; SearchError for an unknown name or option."""
+    cls = searcher_class(name)
+    known = {f.name for f in fields(cls)}
+    bad = sorted(set(options) - known)
+    if bad:
+        raise SearchError(f"searcher {name!r} has no option {', '.join(bad)} (options: {', '.join(sorted(known))})")
+    return cls(**options)
+
+
+def run_search(problem, reward, searcher="mcts", budget=DEFAULT_BUDGET, seed=0, *, until="first",
+               top_k=DEFAULT_TOP_K, progress=None, recorder=None, **options) -> Outcome:
+    """Search any ``core.protocols.Simulator`` (e.g. a toy) with a reward ``reward(measures, last_action, unsafe)``
+    -> (reward, risk).
+    ``recorder``: a ``Recorder`` made by the caller (e.g. ``distinct.DistinctRecorder``)."""
+    check_common(budget, seed, until, top_k)
+    s = searcher if not isinstance(searcher, str) else make_searcher(searcher, **options)
+    rec = recorder if recorder is not None else Recorder(int(budget), until, int(top_k), progress)
+    try:
+        s.run(problem, reward, rec, int(seed))
+    except Stop:
+        pass
+    return Outcome(rec.episodes, tuple(rec.hazards), tuple(rec.top.best()), tuple(rec.risks))
+
+
+def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int = 0, *, until: str = "first",
+           top_k: int = DEFAULT_TOP_K, progress=None, distinct: bool = False, **options) -> SearchResult:
+    """Search a cell (built-in name, path, ``Cell`` or ``Simulator``) for an unsafe action sequence.
+
+    ``searcher`` is ``random``, ``mcts``, ``mcts-commit``, ``evolve`` or ``plan``; ``options`` are its parameters
+    (see ``MCTS``, ``MCTSCommit``, ``RandomSearch``, ``Evolve``, ``Plan``). ``until="first"`` stops at the first hazard,
+    ``until="budget"`` plays the whole budget. ``progress(episodes, best_risk)`` is called after each episode.
+    ``distinct=True`` (with ``until="budget"``) clusters the hazards into classes and steers the search away
+    from classes already found (``search.distinct``); the result lists each class's first hazard. A cell with
+    several start points (``human.starts``) lets each episode's first decision pick one (``search.multistart``);
+    with ``evolve`` and ``plan`` the distinct mode instead shares the budget between the start points in slices
+    (``search.slices``; ``plan`` needs it on such a cell).
+    """
+    check_common(budget, seed, until, top_k)
+    s = make_searcher(searcher, **options)
+    sim = cell if isinstance(cell, Simulator) else Simulator(cell)
+    c = sim.cell
+    if distinct and until != "budget":
+        raise SearchError("distinct needs until='budget' (--until budget --distinct)")
+    reward = sim.criterion.reward(sim.actions_per_episode)
+    problem = sim
+    names = None
+    if c.spec.human.starts:
+        problem = MultiStartProblem(sim)
+        names = problem.names
+    rec = None
+    missing = [p.__name__ for p in getattr(type(s), "needs", ()) if not isinstance(problem, p)]
+    if missing and not (distinct and type(s).whole_episodes):
+        raise SearchError(f"searcher {s.name!r} needs a problem with {', '.join(missing)}"
+                          + (" (on a cell with several start points, add --distinct: each start point then gets "
+                             "its own searches)" if c.spec.human.starts else ""))
+    if distinct and type(s).whole_episodes:  # the budget in slices shared by the starts
+        starts = cell_starts(problem, reward)
+        rec = ClassRecorder(int(budget), until, int(top_k), progress, n_starts=len(starts))
+        out = run_slices(s, starts, reward, rec, int(seed))
+    else:
+        if distinct:
+            problem = distinct_problem(problem, sim, reward)
+            reward = DistinctReward(reward)
+            rec = DistinctRecorder(int(budget), until, int(top_k), progress, problem=problem)
+        out = run_search(problem, reward, s, budget, seed, until=until, top_k=top_k, progress=progress,
+                         recorder=rec)
+
+    if names is None:
+        def names(actions):
+            return [ACTION_NAMES[a] for a in actions]
+
+    def hazard_record(actions):
+        trace = sim.run(names(actions))
+        return trace, trace.records()[trace.unsafe_row]
+
+    hazard = None
+    first = out.first_hazard
+    if first is not None:
+        trace = sim.run(names(first.actions))
+        records = trace.records()
+        hit = records[trace.unsafe_row]
+        hazard = {
+            "episode": first.index,
+            "actions": names(first.actions),
+            "step": hit["step"],
+            "time_s": hit["t"],
+            "robot_link": hit["robot_link"],
+            "body_part": hit["body_part"],
+            "point": hit["robot_point"],
+            "human_point": hit["human_point"],
+            "v_R": hit["v_R"],
+            "d_HR": hit["d_HR"],
+            "trace": records,
+        }
+        verdict = sim.verdict(trace.rows[trace.unsafe_row])
+        if verdict is not None:  # a criterion that judges contacts: its account of this one
+            hazard[sim.criterion.type] = verdict.as_dict()
+    return SearchResult(
+        # a cell file by its absolute path, so that `cellstress replay` works from any folder
+        cell={"name": c.name, "sha256": c.sha256,
+              "source": c.source if c.directory is None else str(Path(c.source).expanduser().resolve()),
+              **_criterion_override(c)},
+        searcher=s.name,
+        params=asdict(s),
+        seed=int(seed),
+        budget=int(budget),
+        until=until,
+        found=out.found,
+        episodes=out.episodes,
+        hazard=hazard,
+        hazards=[{"episode": h.index, "actions": names(h.actions)} for h in out.hazards],
+        top=[{"episode": e.index, "actions": names(e.actions), "return": e.ret, "risk": e.risk,
+              "unsafe": e.unsafe} for e in out.top],
+        risk_per_episode=list(out.risks),
+        version=__version__,
+        distinct=None if rec is None else _distinct_list(rec.classes, names, hazard_record),
+    )
+
+
+def _distinct_list(classes, names, hazard_record) -> list[dict]:
+    out = []
+    for key, (episode, actions) in classes.items():
+        trace, hit = hazard_record(actions)
+        out.append({"class": class_dict(key), "episode": episode, "actions": names(actions), "step": hit["step"],
+                    "time_s": hit["t"], "robot_link": hit["robot_link"], "body_part": hit["body_part"],
+                    "v_R": hit["v_R"], "trace": trace.records()})
+    return out
+
+
+def _criterion_override(cell) -> dict:
+    """{"criterion": name} unless the cell is judged by the paper's criterion (the default, which keeps older
+    result files as they were); replay and report apply it with ``cell.load.with_criterion``."""
+    t = cell.spec.criterion.type
+    return {} if t == "contact-while-moving" else {"criterion": t}

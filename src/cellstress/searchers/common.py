@@ -1,0 +1,161 @@
+"""Machinery shared by all searchers: the episode budget, top-k, records, rollouts, option checks.
+
+A searcher sees a *problem*: any ``core.protocols.Simulator`` (``reset()`` -> s0, a pure
+``step(state, action)`` -> (next state, rows), ``is_unsafe(state)``, ``measures(rows)`` for the reward,
+``n_actions`` and ``actions_per_episode``). The cell simulator is one; the tests use a 1-D toy walk.
+The reward comes from the criterion (``Criterion.reward``): ``reward(measures, last_action, unsafe)`` ->
+(reward, risk). Returns are undiscounted sums over the episode.
+
+Randomness: every searcher draws from numpy Generators made from ``SeedSequence(seed)``; no global state.
+"""
+
+from __future__ import annotations
+
+import heapq
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cellstress.core.errors import CellstressError
+
+UNTIL = ("first", "budget")
+
+
+class SearchError(CellstressError):
+    """A bad search option (unknown searcher, budget < 1, negative seed, ...)."""
+
+
+@dataclass(frozen=True)
+class Episode:
+    """One finished episode: the actions played (up to the unsafe one), its return and max risk."""
+
+    index: int  # 1-based episode number
+    actions: tuple[int, ...]
+    ret: float
+    risk: float
+    unsafe: bool
+
+
+class TopK:
+    """The k episodes with the highest return, keyed by action sequence (ties: the earlier episode wins)."""
+
+    def __init__(self, k: int):
+        self.k = k
+        self._heap: list[tuple[float, int, tuple[int, ...], Episode]] = []
+        self._keys: dict[tuple[int, ...], Episode] = {}
+
+    def add(self, ep: Episode) -> None:
+        if self.k <= 0:
+            return
+        old = self._keys.get(ep.actions)
+        if old is not None:  # deterministic simulator: the same sequence always gives the same return
+            return
+        item = (ep.ret, -ep.index, ep.actions, ep)
+        if len(self._heap) < self.k:
+            heapq.heappush(self._heap, item)
+            self._keys[ep.actions] = ep
+        elif item[:2] > self._heap[0][:2]:
+            gone = heapq.heapreplace(self._heap, item)
+            del self._keys[gone[2]]
+            self._keys[ep.actions] = ep
+
+    def best(self) -> list[Episode]:
+        return [it[3] for it in sorted(self._heap, key=lambda it: it[:2], reverse=True)]
+
+
+class Stop(Exception):
+    """Raised inside a searcher when the search is over (budget used up, or first hazard with until=first)."""
+
+
+@dataclass
+class Recorder:
+    """Counts episodes against the budget and keeps what the result needs.
+
+    Every searcher calls ``finish`` exactly once per episode (an iteration); it raises ``Stop`` when the
+    search is over, so no searcher can overrun the budget.
+    """
+
+    budget: int
+    until: str = "first"
+    top_k: int = 10
+    progress: Callable[[int, float], None] | None = None
+    episodes: int = 0
+    risks: list[float] = field(default_factory=list)
+    hazards: list[Episode] = field(default_factory=list)
+    best_risk: float = 0.0
+
+    def __post_init__(self):
+        self.top = TopK(self.top_k)
+
+    @property
+    def left(self) -> int:
+        return self.budget - self.episodes
+
+    def finish(self, actions, ret: float, risk: float, unsafe: bool) -> Episode:
+        if self.episodes >= self.budget:
+            raise Stop
+        self.episodes += 1
+        ep = Episode(self.episodes, tuple(int(a) for a in actions), float(ret), float(risk), bool(unsafe))
+        self.risks.append(ep.risk)
+        self.best_risk = max(self.best_risk, ep.risk)
+        self.top.add(ep)
+        if unsafe:
+            self.hazards.append(ep)
+        if self.progress is not None:
+            self.progress(self.episodes, self.best_risk)
+        if (unsafe and self.until == "first") or self.episodes >= self.budget:
+            raise Stop
+        return ep
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a searcher produced on a problem (no cell facts yet: see ``result.SearchResult``)."""
+
+    episodes: int
+    hazards: tuple[Episode, ...]
+    top: tuple[Episode, ...]
+    risks: tuple[float, ...]
+
+    @property
+    def found(self) -> bool:
+        return bool(self.hazards)
+
+    @property
+    def first_hazard(self) -> Episode | None:
+        return self.hazards[0] if self.hazards else None
+
+
+def rollout(problem, reward, state, actions: list[int], risk: float, rng: np.random.Generator):
+    """Play uniformly random actions from ``state`` to the horizon; ``actions`` (the prefix) is extended.
+
+    Returns (return of the rollout part, max risk incl. ``risk``, unsafe)."""
+    n = problem.actions_per_episode
+    depth = len(actions)
+    if depth >= n or problem.is_unsafe(state):
+        return 0.0, risk, problem.is_unsafe(state)
+    draws = rng.integers(0, problem.n_actions, size=n - depth).tolist()
+    total = 0.0
+    for k, a in enumerate(draws, start=depth):
+        state, rows = problem.step(state, a)
+        actions.append(a)
+        unsafe = problem.is_unsafe(state)
+        r, rk = reward(problem.measures(rows), k == n - 1, unsafe)
+        total += r
+        if rk > risk:
+            risk = rk
+        if unsafe:
+            return total, risk, True
+    return total, risk, False
+
+
+def check_common(budget, seed, until, top_k) -> None:
+    if isinstance(budget, bool) or not isinstance(budget, (int, np.integer)) or budget < 1:
+        raise SearchError(f"budget must be a whole number of episodes >= 1, not {budget!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise SearchError(f"seed must be a whole number >= 0, not {seed!r}")
+    if until not in UNTIL:
+        raise SearchError(f"until must be one of {', '.join(UNTIL)}, not {until!r}")
+    if isinstance(top_k, bool) or not isinstance(top_k, (int, np.integer)) or top_k < 0:
+        raise SearchError(f"top_k must be a whole number >= 0, not {top_k!r}")

@@ -1,0 +1,62 @@
+"""MCTS1 of the paper: MCTS with double progressive widening from s0 for the whole budget.
+
+(AdaptiveStressTesting.jl's ``stress_test2``.) One iteration = one episode: it descends the tree from s0,
+adds one node, values it by a uniform random rollout to the horizon, and backs up the undiscounted return.
+
+Defaults (measured on the flawed reference cells, seeds 0..9, budget 200; see the search tests):
+
+* ``ec`` = 0.5, not the 100 of AdaptiveStressTesting.jl's examples (whose rewards are log-likelihoods).
+  Here the per-step reward is 1/c_S <= e^{v_R} (about 0.1..3 for v_R <= 1.1 m/s) and the terminal penalty
+  -c_S runs from about -1 (ending next to the robot) to about -30 (ending 5 m away). Branches ending far
+  away are dismissed after a visit or two whatever ec is; what steers the search is the difference between
+  promising prefixes, which is small: on S2 the mean rollout return after the three best first actions is
+  about 3.1 against 2.35 for the rest, with a spread of about 1.1. ec should be of that order. With ec = 10
+  (or 100) the bonus swamps those differences and MCTS1 is little better than random (S2: 1 of 6 seeds);
+  ec = 0.5 found the S2 hazard for 7-8 of 10 seeds. On a problem with a larger return spread, scale ec
+  with it (the toy walk in the tests locks onto wrong prefixes with ec = 0.5 if its distances are in
+  metres-per-step instead of 0.25 m).
+* ``k`` = 1.0 (AdaptiveStressTesting.jl: 0.5) and ``alpha`` = 0.85. A node may widen while
+  |children| <= k N^alpha. With 30 actions and a budget of 200 episodes, k = 0.5 tries all 30 root
+  actions only after ~120 iterations and, in MCTS2, only ~8 of them before the first commitment (n = 25);
+  k = 1.0 halves that (all 30 by ~55 iterations; ~16 before committing). Measured: MCTS2 on S2 found
+  the hazard for 4 of 10 seeds with k = 1 against 1 of 10 with k = 0.5; k = 2 was worse again (3 of 10).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+from cellstress.searchers.common import Recorder, SearchError
+from cellstress.searchers.tree import Tree
+
+
+@dataclass(frozen=True)
+class MCTS:
+    """Options of ``mcts`` (MCTS1): exploration constant ``ec``, widening ``k`` and ``alpha``."""
+
+    ec: float = 0.5
+    k: float = 1.0
+    alpha: float = 0.85
+
+    name: ClassVar[str] = "mcts"
+    needs: ClassVar[tuple[type, ...]] = ()
+    whole_episodes: ClassVar[bool] = False
+    paper_name: ClassVar[str | None] = "MCTS1"
+    color: ClassVar[str | None] = "#1f77b4"
+
+    def __post_init__(self):
+        check_dpw(self.ec, self.k, self.alpha)
+
+    def run(self, problem, reward, rec: Recorder, seed: int) -> None:
+        tree = Tree(problem, reward, rec, seed, self.ec, self.k, self.alpha)
+        while True:
+            tree.iterate(tree.root, 0.0, 0.0)  # Recorder.finish raises Stop at the end
+
+
+def check_dpw(ec, k, alpha) -> None:
+    for name, v in (("ec", ec), ("k", k), ("alpha", alpha)):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not v == v or v < 0 or v == float("inf"):
+            raise SearchError(f"{name} must be a finite number >= 0, not {v!r}")
+    if k == 0:
+        raise SearchError("k must be > 0 (with k = 0 the root never widens)")

@@ -1,0 +1,280 @@
+"""``plan``: model-based search (issue 4, part 6). Learn the robot and its safety devices from the episodes
+played, and play the action sequence the model expects to bring the worker closest to the moving robot.
+
+Not one of the paper's searchers (those stay as specified: ``mcts``, ``mcts-commit``). ``evolve`` treats the
+simulator as a black box; ``plan`` separates what the searcher controls from what it tests:
+
+* **The worker is the searcher's own agent.** Where an action sequence takes the worker, and how far the
+  worker's body and reach volumes are from a given point, depend on the actions and the fixed layout (walls,
+  table, floor) only, so they are computed without playing anything (``Simulator.worker_paths``,
+  ``Simulator.worker_distances``).
+* **The robot system under test is learned** from the metric rows of the episodes played, and from nothing
+  else:
+
+  - *the robot*: until a stop takes effect it runs its programmed path, so its pose is a function of time
+    alone. The robot point a row names (the one closest to the worker) at time step k therefore lies on the
+    robot at step k in every episode that has not been stopped by then. The model keeps these points per
+    step, each with its *offset* (the worker's distance to it at the row's pose, less the row's d_HR), and the
+    robot's speed v_R at each step;
+  - *the devices*: whether a device sees the worker at a pose (the nearest pose of any row decides), and, per
+    device, the time steps from the first detection to braking and to standstill (medians over the episodes
+    that showed them; unknown: the robot is taken to keep moving);
+  - a played prefix of a sequence is not predicted: its real rows (d_HR, v_R, detections, stop phase) are used.
+
+1. **Start**: ``n_init`` episodes of sticky random actions (each action repeats the previous one with
+   probability ``init_sticky``), none played twice, as in ``evolve``.
+2. **Candidates**: ``candidates`` sequences not played yet: with probability ``explore`` a sticky random one
+   (repeat probability ``sticky``), else a mutation of one of the ``pool`` played episodes whose worker came
+   closest to the robot before any device reacted: one action changed at a random position, and the parent's
+   remaining actions kept (probability ``keep_tail``) or drawn afresh.
+3. **Prediction**: a candidate's *predicted clearance* is the smallest, over its steps after the played prefix,
+   before the predicted standstill and at which the robot moves (its v_R above the criterion's tolerance), of the
+   worker's distance to the robot points of that step (while braking: of the step the braking began) less their
+   offsets. Since those points lie on the robot, a prediction of 0 or less says the worker's reach contains a
+   point of the moving robot. The played prefix is not scored: its outcome is known (no hazard), and scoring it
+   kept an early version replaying the tails of one close but already stopped prefix.
+4. **Play** the candidate with the smallest predicted clearance (ties: at random); learn from its rows; repeat
+   from 2 until the budget is used up or the first hazard is found.
+
+Every episode is one action sequence played from s0 and counted, as for the other searchers; what the model
+computes plays no episode. It needs a cell's simulator (``SimProblem``) with one start point; on a cell with
+several (``all-flaws``) it runs with ``--distinct``, whose slices give each start point its own searches
+(``search.slices``). It does not use the slices' ``known_hazard`` hook: a class already found is not steered
+away from, so most of a ``--until budget`` run's episodes rediscover known classes.
+
+Defaults (``n_init`` = 2, ``init_sticky`` = 0.9, ``candidates`` = 200, ``explore`` = 0.3, ``sticky`` = 0.3,
+``pool`` = 5, ``keep_tail`` = 0.5) were chosen on the three flawed cells, seeds 0-39, budget 200;
+docs/results.md gives the numbers and the settings tried.
+
+Randomness: one numpy Generator from ``SeedSequence(seed, spawn_key=(9,))``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from cellstress.core.protocols import WorkerModel
+from cellstress.searchers.common import Recorder, SearchError
+from cellstress.searchers.evolve import REDRAWS
+from cellstress.sim import kernels as K
+
+PLAN_KEY = 9
+POINT_GRID = 0.02  # robot points closer than this (per coordinate, rounded) are kept as one, with the least offset
+POSE_WEIGHTS = (1.0, 1.0, 0.3, 0.4)  # nearest-pose metric: x, y [m]; heading as 0.3 (cos, sin); flexions 0.4/rad
+
+
+@dataclass(frozen=True)
+class Plan:
+    """Options of ``plan``: ``n_init`` start episodes with repeat probability ``init_sticky``; per episode,
+    ``candidates`` unplayed sequences, a share ``explore`` of them sticky random (repeat probability
+    ``sticky``), the others mutations of the ``pool`` closest played episodes with the tail kept with
+    probability ``keep_tail``. See the module docstring."""
+
+    n_init: int = 2
+    init_sticky: float = 0.9
+    candidates: int = 200
+    explore: float = 0.3
+    sticky: float = 0.3
+    pool: int = 5
+    keep_tail: float = 0.5
+
+    name: ClassVar[str] = "plan"
+    needs: ClassVar[tuple[type, ...]] = (WorkerModel,)
+    whole_episodes: ClassVar[bool] = True  # with --distinct it runs in slices per start point
+    paper_name: ClassVar[str | None] = None
+    color: ClassVar[str | None] = "#9467bd"
+
+    def __post_init__(self):
+        for k, lo in (("n_init", 1), ("candidates", 1), ("pool", 1)):
+            v = getattr(self, k)
+            if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+                raise SearchError(f"{k} must be a whole number >= {lo}, not {v!r}")
+        for k in ("init_sticky", "explore", "sticky", "keep_tail"):
+            v = getattr(self, k)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= v <= 1.0:
+                raise SearchError(f"{k} must be a number in 0..1, not {v!r}")
+
+    def run(self, problem, reward, rec: Recorder, seed: int) -> None:
+        if not isinstance(problem, WorkerModel):
+            raise SearchError("plan searches a cell's simulator from one start point (for a cell with several, "
+                              "add --distinct: each start point then gets its own searches)")
+        rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(PLAN_KEY,)))
+        horizon, n_actions = problem.actions_per_episode, problem.n_actions
+        model = _Model(problem)
+        # played sequence -> its least d_HR before any device reacted; a key shorter than the horizon is an
+        # episode cut short by a hazard (with until="budget"), which any sequence beginning with it would replay
+        closest: dict[tuple[int, ...], float] = {}
+
+        def replays(seq: tuple[int, ...]) -> bool:
+            return any(seq[:p] in closest for p in range(1, len(seq) + 1))
+
+        def sticky_tail(actions: list[int], repeat: float) -> list[int]:
+            while len(actions) < horizon:
+                prev = actions[-1] if actions else -1
+                actions.append(prev if prev >= 0 and rng.random() < repeat else int(rng.integers(n_actions)))
+            return actions
+
+        def play(actions: list[int]) -> None:
+            state, ret, risk, unsafe, rows, played = problem.reset(), 0.0, 0.0, False, [], []
+            for k, a in enumerate(actions):
+                state, r = problem.step(state, a)
+                rows.append(np.array(r))
+                played.append(a)
+                unsafe = bool(problem.is_unsafe(state))
+                rw, rk = reward(problem.measures(r), k == horizon - 1, unsafe)
+                ret, risk = ret + rw, max(risk, rk)
+                if unsafe:
+                    break
+            rows = np.concatenate(rows)
+            model.learn(played, rows)
+            running = rows[rows[:, K.M_PHASE] == K.PHASE_RUNNING, K.M_D]
+            closest[tuple(played)] = float(running.min()) if len(running) else math.inf
+            rec.finish(played, ret, risk, unsafe)  # raises Stop at the end
+
+        for _ in range(self.n_init):
+            for _ in range(REDRAWS):  # very sticky episodes are often constant sequences: play each once
+                actions = sticky_tail([], self.init_sticky)
+                if not replays(tuple(actions)):
+                    break
+            play(actions)
+        while True:
+            parents = [list(a) for a, _ in sorted(closest.items(), key=lambda kv: kv[1])[: self.pool]]
+            cands: set[tuple[int, ...]] = set()
+            for _ in range(20 * self.candidates):
+                if rng.random() < self.explore:
+                    child = sticky_tail([], self.sticky)
+                else:
+                    parent = parents[int(rng.integers(len(parents)))]
+                    j = int(rng.integers(horizon))
+                    child = parent[:j] + [int(rng.integers(n_actions))]
+                    if rng.random() < self.keep_tail:
+                        child += parent[j + 1:]
+                    child = sticky_tail(child, self.sticky)
+                if not replays(tuple(child)):
+                    cands.add(tuple(child))
+                    if len(cands) >= self.candidates:
+                        break
+            if not cands:  # (every sequence near the played ones has been played: a tiny action space)
+                cands.add(tuple(sticky_tail([], 0.0)))
+            order = np.array(sorted(cands), dtype=np.int64)
+            score = model.predict(order)
+            ties = np.flatnonzero(score <= score.min())
+            play([int(a) for a in order[ties[int(rng.integers(len(ties)))]]])
+
+
+class _Model:
+    """What ``plan`` has learned of the robot and the devices, and its predictions (module docstring)."""
+
+    def __init__(self, sim):
+        self.sim = sim
+        self.spa, self.horizon = sim.steps_per_action, sim.actions_per_episode
+        self.n_steps = self.horizon * self.spa
+        self.v_tol = float(sim.params.scal[K.C_VTOL])
+        self.pose_cols = [K.M_X, K.M_Y, K.M_HEADING, K.M_FWD, K.M_LAT]
+        self.points: list[dict] = [{} for _ in range(self.n_steps + 1)]  # step -> {cell: (point, offset)}
+        self.speed = np.full(self.n_steps + 1, np.nan)  # v_R on the programmed path, per step (1-based)
+        self.delays: dict[int, list[tuple[int, int]]] = {}  # device mask -> [(to braking, to standstill)]
+        # played prefix -> (its rows' count, devices seen per row, first braking and standstill row or -1)
+        self.prefixes: dict[tuple[int, ...], tuple[int, np.ndarray, int, int]] = {}
+        self.feats: list[np.ndarray] = []
+        self.seen: list[np.ndarray] = []
+        self._tree = self._by_step = None
+
+    def _features(self, poses: np.ndarray) -> np.ndarray:
+        wx, wy, wh, wf = POSE_WEIGHTS
+        return np.column_stack([wx * poses[:, 0], wy * poses[:, 1], wh * np.cos(poses[:, 2]),
+                                wh * np.sin(poses[:, 2]), wf * poses[:, 3], wf * poses[:, 4]])
+
+    def learn(self, actions: list[int], rows: np.ndarray) -> None:
+        seen = rows[:, K.M_SEEN].astype(np.int64)
+        braking = np.flatnonzero(rows[:, K.M_PHASE] >= K.PHASE_BRAKING)
+        stopped = np.flatnonzero(rows[:, K.M_PHASE] >= K.PHASE_STOPPED)
+        for p in range(1, len(actions) + 1):
+            n = min(p * self.spa, len(rows))
+            b = int(braking[0]) if len(braking) and braking[0] < n else -1
+            s = int(stopped[0]) if len(stopped) and stopped[0] < n else -1
+            self.prefixes[tuple(actions[:p])] = (n, seen[:n], b, s)
+        on_path = rows[rows[:, K.M_PHASE] <= K.PHASE_PENDING]
+        if len(on_path):
+            pts = on_path[:, [K.M_RX, K.M_RY, K.M_RZ]]
+            reach = self.sim.worker_distances(on_path[:, self.pose_cols], pts[:, None, :])[:, 0]
+            for row, point, dist in zip(on_path, pts, reach, strict=True):
+                k = int(row[K.M_STEP])
+                self.speed[k] = row[K.M_V]
+                cell = tuple(np.round(point / POINT_GRID).astype(int))
+                offset = float(dist - row[K.M_D])
+                old = self.points[k].get(cell)
+                if old is None or offset < old[1]:
+                    self.points[k][cell] = (point, offset)
+        if seen.any():
+            first = int(np.argmax(seen > 0))
+            if len(stopped):
+                self.delays.setdefault(int(seen[first]), []).append((int(braking[0]) - first,
+                                                                      int(stopped[0]) - first))
+        self.feats.append(self._features(rows[:, self.pose_cols]))
+        self.seen.append(seen)
+        self._tree = self._by_step = None
+
+    def _step_points(self) -> tuple[np.ndarray, np.ndarray]:
+        """The robot points and offsets of every step, padded with NaN points: (steps + 1, m, 3), (steps + 1, m)."""
+        if self._by_step is None:
+            m = max(1, max(len(p) for p in self.points))
+            pts = np.full((self.n_steps + 1, m, 3), np.nan)
+            off = np.zeros((self.n_steps + 1, m))
+            for k, found in enumerate(self.points):
+                for i, (point, offset) in enumerate(found.values()):
+                    pts[k, i], off[k, i] = point, offset
+            self._by_step = pts, off
+        return self._by_step
+
+    def predict(self, seqs: np.ndarray) -> np.ndarray:
+        """The predicted clearance of each sequence (module docstring, 3.)."""
+        from scipy.spatial import cKDTree
+
+        n, steps = len(seqs), self.n_steps
+        if self._tree is None:
+            self._tree = (cKDTree(np.concatenate(self.feats)), np.concatenate(self.seen))
+        tree, seen_at = self._tree
+        poses = self.sim.worker_paths(seqs).reshape(-1, 5)
+        seen = seen_at[tree.query(self._features(poses))[1]].reshape(n, steps)
+        known = np.zeros(n, dtype=np.int64)
+        played_brake = np.full(n, -1)
+        played_stop = np.full(n, -1)
+        for i, seq in enumerate(map(tuple, seqs.tolist())):
+            p = len(seq) - 1
+            while p > 0 and seq[:p] not in self.prefixes:
+                p -= 1
+            if p:
+                known[i], seen_k, played_brake[i], played_stop[i] = self.prefixes[seq[:p]]
+                seen[i, : known[i]] = seen_k
+        # the stop after the first detection, by the delays learned for the devices that saw the worker first
+        # (unknown devices: the robot is taken to keep moving); where the played prefix shows it, as it happened
+        brake = np.full(n, steps)
+        stop = np.full(n, steps)
+        detected = seen.any(axis=1)
+        first = (seen > 0).argmax(axis=1)
+        mask = seen[np.arange(n), first]
+        for m in np.unique(mask[detected]):
+            delays = self.delays.get(int(m))
+            if delays:
+                sel = detected & (mask == m)
+                brake[sel] = first[sel] + int(np.median([b for b, _ in delays]))
+                stop[sel] = first[sel] + int(np.median([s for _, s in delays]))
+        brake = np.where(played_brake >= 0, played_brake, brake)
+        stop = np.where(played_stop >= 0, played_stop, stop)
+        # the robot step each candidate step meets (0-based step k -> row step k + 1; braking: its first step)
+        k = np.arange(steps)[None, :]
+        robot_step = np.minimum(k, brake[:, None]) + 1
+        use = (k >= known[:, None]) & (k < stop[:, None]) & (np.nan_to_num(self.speed[robot_step]) > self.v_tol)
+        pts, off = self._step_points()
+        which = np.flatnonzero(use.ravel())
+        dist = np.full(n * steps, np.inf)
+        if len(which):
+            rs = robot_step.ravel()[which]
+            d = self.sim.worker_distances(poses[which], pts[rs]) - off[rs]
+            dist[which] = d.min(axis=1)
+        return dist.reshape(n, steps).min(axis=1)

@@ -1,0 +1,59 @@
+"""The closest point pair of a metric row as a ``core.records.Contact``: for criteria that judge contacts.
+
+Everything a criterion may need about a contact that the compiled loop does not compute: the ISO/TS 15066
+body region of the human point (``human.regions``), the contact normal (``scene.contact_normal``), the robot's
+joint state at that step (from the kernel's own trajectory) and, from pinocchio, the robot point's velocity
+towards the human and the robot's reflected mass along the normal (``robot.dynamics``). Contacts are rare, so
+this runs in Python, outside the hot loop.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from cellstress.core.records import Contact
+from cellstress.human.body import BODY_PARTS
+from cellstress.human.regions import body_region
+from cellstress.robot.dynamics import point_dynamics, reflected_mass
+from cellstress.robot.model import load_pinocchio
+from cellstress.sim import kernels as K
+from cellstress.sim import scene
+from cellstress.sim.build import Layout
+
+
+class ContactModel:
+    """Contacts of one simulator layout (pinocchio model and data made once, like the simulator's work arrays)."""
+
+    def __init__(self, layout: Layout):
+        self.layout = layout
+        self.model = load_pinocchio(layout.robot.urdf)
+        self.data = self.model.createData()
+        P = layout.params
+        self.R_base = np.asarray(P.base[:3, :3])
+        self.t_base = np.asarray(P.base[:3, 3])
+
+    def contact(self, row: np.ndarray) -> Contact:
+        """The closest points of a metric row, with the region, normal, v_rel and reflected mass there."""
+        lay, P = self.layout, self.layout.params
+        link, part = int(row[K.M_LINK]), int(row[K.M_PART])
+        rp = np.array(row[K.M_RX:K.M_RZ + 1], dtype=float)
+        hp = np.array(row[K.M_HX:K.M_HZ + 1], dtype=float)
+        pose = scene.body_pose(lay, row[K.M_X], row[K.M_Y], row[K.M_HEADING], row[K.M_FWD], row[K.M_LAT])
+        q, qd = scene.joint_state(lay, row)
+        n = scene.contact_normal(lay, row, pose)
+        b = lay.body
+        region = body_region(part, hp, pose, b.height, b.upper_arm, b.forearm)
+        j = int(P.cap_joint[link])
+        if j < 0:  # a capsule on the fixed base
+            v_rel, m_r = 0.0, math.inf
+        else:
+            pb = self.R_base.T @ (rp - self.t_base)  # pinocchio works in the robot base frame
+            nb = self.R_base.T @ n
+            Jp, M = point_dynamics(self.model, self.data, q, j + 1, pb)
+            m_r = reflected_mass(Jp, M, nb)
+            v_rel = max(0.0, float(nb @ (Jp @ qd)))
+        return Contact(float(row[K.M_D]), float(row[K.M_V]), lay.capsules[link].name, BODY_PARTS[part], region,
+                       (float(rp[0]), float(rp[1]), float(rp[2])), (float(hp[0]), float(hp[1]), float(hp[2])),
+                       (float(n[0]), float(n[1]), float(n[2])), v_rel, m_r)
