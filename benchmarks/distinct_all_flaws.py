@@ -29,7 +29,7 @@ RUNS = {"random": ("random", False), "mcts": ("mcts", False), "mcts --distinct":
 
 def classes_of(sim, res):
     """[(episode, start name, class key)] of a result's hazards, each class once, in the order found."""
-    from cellstress.searchers.multistart import split_start
+    from cellstress.sim.starts import split_start
 
     if res.distinct is not None:
         return [(d["episode"], d["actions"][0], (d["class"]["device"], d["class"]["robot_link"],

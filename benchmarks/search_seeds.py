@@ -5,7 +5,7 @@ python benchmarks/search_seeds.py [--searchers random,mcts,mcts-commit,evolve] [
 
 Each run stops at its first hazard; a failed run counts as the budget (as in the campaign). ``--set`` passes an
 option to every searcher that has it (e.g. ``--set score='"risk"'`` for evolve). Prints one Markdown row per
-searcher: found and mean episodes per cell. Same code path as the campaign (``run_search`` on ``SimProblem``).
+searcher: found and mean episodes per cell. Same code path as the campaign (``run_search`` on the cell ``Simulator``).
 """
 
 from __future__ import annotations
@@ -15,9 +15,7 @@ import json
 import statistics
 from dataclasses import fields
 
-from cellstress.criteria import criterion_for
-from cellstress.searchers import SEARCHERS, make_searcher, run_search
-from cellstress.searchers.common import Reward, SimProblem
+from cellstress.searchers import make_searcher, run_search, searcher_class
 from cellstress.sim.simulator import Simulator
 
 CELLS = ("s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap")
@@ -37,11 +35,11 @@ def main() -> None:
     problems = {}
     for c in cells:
         sim = Simulator(c)
-        problems[c] = (SimProblem(sim), Reward(criterion_for(sim.cell.spec.criterion)))
+        problems[c] = (sim, sim.criterion.reward(sim.actions_per_episode))
     print("| seeds | searcher | " + " | ".join(f"{c} found | {c} mean" for c in cells) + " |")
     print("|---|---|" + "---:|---:|" * len(cells))
     for name in args.searchers.split(","):
-        known = {f.name for f in fields(SEARCHERS[name])}
+        known = {f.name for f in fields(searcher_class(name))}
         mine = {k: v for k, v in opts.items() if k in known}
         cols = []
         for c in cells:

@@ -37,14 +37,14 @@ def main(argv=None) -> None:
 
     if args.threads:
         numba.set_num_threads(args.threads)
-    from cellstress.searchers import SEARCHERS, search
+    from cellstress.searchers import search, searcher_class, searcher_names
     from cellstress.sim.simulator import Simulator
 
     rows = []
     for cell in args.cells:
         sim = Simulator(cell)
-        for name in args.searchers or list(SEARCHERS):
-            known = {f.name for f in fields(SEARCHERS[name])}
+        for name in args.searchers or list(searcher_names()):
+            known = {f.name for f in fields(searcher_class(name))}
             mine = {k: v for k, v in opts.items() if k in known}
             search(sim, name, budget=50, seed=0, until="budget", **mine)  # warm-up
             rates, found = [], 0

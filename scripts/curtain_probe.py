@@ -1,4 +1,4 @@
-"""Brute-force probe behind a cell's light curtain (``cellstress.sim.probe``): how close the robot comes to an
+"""Brute-force probe behind a cell's light curtain (``cellstress.analysis.probe``): how close the robot comes to an
 unseen worker standing still.
 
     python scripts/curtain_probe.py [CELL] [--step 0.05]
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import argparse
 
-from cellstress.sim.probe import probe
+from cellstress.analysis.probe import probe
 
 
 def main() -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from cellstress.sim.probe import probe
+from cellstress.analysis.probe import probe
 
 
 @pytest.mark.slow

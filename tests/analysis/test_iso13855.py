@@ -10,47 +10,10 @@ import numpy as np
 import pytest
 import yaml
 
-from cellstress.cell import iso13855 as iso
+from cellstress.analysis import iso13855 as iso
 from cellstress.cell.load import builtin_text, load_cell
 
 CELLS = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap")
-
-
-# ---- ISO 13855 arithmetic ---------------------------------------------------------------------------------
-def test_scanner_distance_by_hand():
-    # T = 0.35 s scanner + 0.15 s stopping; H = 300 mm: 1600 * 0.5 + (1200 - 0.4 * 300) = 800 + 1080
-    d = iso.scanner_distance(0.35 + 0.15, 300.0)
-    assert (d.K, d.C) == (1600.0, 1080.0)
-    assert d.S == pytest.approx(1880.0)
-
-
-def test_scanner_intrusion_allowance_is_at_least_850():
-    # H = 1000 mm: 1200 - 400 = 800 < 850, so C = 850
-    d = iso.scanner_distance(0.5, 1000.0)
-    assert d.C == 850.0 and d.S == pytest.approx(800.0 + 850.0)
-
-
-def test_curtain_nominal_by_hand():
-    # d = 30 mm, T = 0.05 + 0.15 s: 2000 * 0.2 + 8 * (30 - 14) = 400 + 128 = 528 > 500,
-    # so 1600 * 0.2 + 128 = 448 mm, below the 500 mm minimum: 500 mm
-    d = iso.curtain_distance_nominal(0.05 + 0.15, 30.0)
-    assert (d.K, d.C) == (1600.0, 128.0)
-    assert d.S == pytest.approx(500.0)
-
-
-def test_curtain_nominal_other_branches():
-    assert iso.curtain_distance_nominal(0.2, 14.0).S == pytest.approx(400.0)  # 2000 * 0.2 + 0 <= 500: K = 2000
-    assert iso.curtain_distance_nominal(0.2, 14.0).K == 2000.0
-    assert iso.curtain_distance_nominal(0.02, 14.0).S == pytest.approx(100.0)  # 40 mm < the 100 mm minimum
-    assert iso.curtain_distance_nominal(0.4, 30.0).S == pytest.approx(640.0 + 128.0)  # 1600 * 0.4 + 128 > 500
-    assert iso.curtain_distance_nominal(0.2, 50.0).S == pytest.approx(1170.0)  # d > 40 mm: 1600 T + 850
-
-
-def test_curtain_body_detection_distance_by_hand():
-    # our devices see only the body: ISO's body-detection allowance C = 850 mm, K = 1600 mm/s
-    d = iso.curtain_distance(0.2, 30.0)
-    assert (d.K, d.C) == (1600.0, 850.0)
-    assert d.S == pytest.approx(320.0 + 850.0)
 
 
 # ---- body numbers used by the check -----------------------------------------------------------------------

@@ -94,21 +94,36 @@ def test_a_run_is_a_pure_function_of_its_spec():
 
 
 def test_new_searchers_plug_in_without_campaign_changes(monkeypatch):
-    """Searcher names and default options come from cellstress.search.SEARCHERS."""
-    from dataclasses import dataclass
+    """Searcher names and default options come from the searcher registry (``cellstress.searchers`` entry
+    points): a registered plug-in runs in a campaign with no change to the campaign code."""
+    from importlib.metadata import EntryPoint
 
-    from cellstress import search as search_pkg
+    from cellstress.core import registry
 
-    @dataclass(frozen=True)
-    class Lazy(search_pkg.RandomSearch):
-        chunk: int = 8
-        name = "lazy-random"
+    real = registry.entry_points
 
-    monkeypatch.setitem(search_pkg.SEARCHERS, "lazy-random", Lazy)
-    plan = resolve(("s1-scanner-width",), ("lazy-random",), 1, 5)
-    assert plan.searchers[0].params_dict == {"chunk": 8}
-    rec = execute(plan.runs()[0])
-    assert (rec["searcher"], rec["params"], rec["episodes"]) == ("lazy-random", {"chunk": 8}, 5)
+    class _Dist:  # the metadata of the plug-in's (imaginary) distribution
+        metadata = {"Name": "lazy-plugin"}
+
+    def entry_points(group):
+        eps = list(real(group=group))
+        if group == "cellstress.searchers":
+            ep = EntryPoint("lazy-random", "campaign_lazy_plugin:Lazy", group)
+            eps.append(type("EP", (), {"name": ep.name, "value": ep.value, "dist": _Dist()})())
+        return eps
+
+    monkeypatch.syspath_prepend(str(Path(__file__).parent))
+    monkeypatch.setattr(registry, "entry_points", entry_points)
+    registry.plugins.cache_clear()
+    registry.load.cache_clear()
+    try:
+        plan = resolve(("s1-scanner-width",), ("lazy-random",), 1, 5)
+        assert plan.searchers[0].params_dict == {"chunk": 8}
+        rec = execute(plan.runs()[0])
+        assert (rec["searcher"], rec["params"], rec["episodes"]) == ("lazy-random", {"chunk": 8}, 5)
+    finally:
+        registry.plugins.cache_clear()
+        registry.load.cache_clear()
 
 
 def test_a_worker_process_uses_one_numba_thread():

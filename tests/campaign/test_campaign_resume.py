@@ -205,7 +205,7 @@ def test_two_campaigns_cannot_share_a_folder(done, tmp_path, capsys):
 
 
 @pytest.mark.parametrize(("args", "says"), [
-    (["--searchers", "nope"], "unknown searcher 'nope' (choose from random, mcts, mcts-commit"),
+    (["--searchers", "nope"], "unknown searcher 'nope' (choose from evolve, mcts, mcts-commit, plan, random"),
     (["--searchers", "mcts,mcts"], "mcts listed more than once"),
     (["--cells", "no-such-cell"], "--cells: no-such-cell: no such file"),
     (["--seeds", "0"], "--seeds must be a whole number >= 1"),

@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from cellstress.criteria import ContactWhileMoving, criterion_for
+from cellstress.core.records import Measures
+from cellstress.criteria.contact import ContactWhileMoving
 from cellstress.sim import kernels as K
 from cellstress.sim.simulator import Simulator
 
@@ -23,15 +24,16 @@ def test_reward_matches_the_paper():
     assert c.safety_index(0.0, 0.0) == 1.0
     assert c.safety_index(1.0, 0.0) == 2.0
     assert c.safety_index(2.0, 1.0) == pytest.approx(5.0 / math.e)
-    assert c.reward(2.0, 1.0, last_action=False, unsafe=False) == pytest.approx(math.e / 5.0)
-    assert c.reward(2.0, 1.0, last_action=True, unsafe=False) == pytest.approx(-5.0 / math.e)
-    assert c.reward(0.0, 1.0, last_action=True, unsafe=True) == pytest.approx(math.e)
+    r = c.reward(8)
+    assert r(Measures(2.0, 1.0), last_action=False, unsafe=False) == pytest.approx((math.e / 5.0, math.e / 5.0))
+    assert r(Measures(2.0, 1.0), last_action=True, unsafe=False)[0] == pytest.approx(-5.0 / math.e)
+    assert r(Measures(0.0, 1.0), last_action=True, unsafe=True)[0] == pytest.approx(math.e)
 
 
 def test_simulator_flags_exactly_the_criterion():
     """Every row of random episodes: the kernel's unsafe flag equals the criterion on its d_HR and v_R."""
     sim = Simulator("s3-fence-gap")
-    crit = criterion_for(sim.cell.spec.criterion)
+    crit = sim.criterion
     rng = np.random.default_rng(3)
     flagged = 0
     for seq in rng.integers(0, 30, (300, 8)):

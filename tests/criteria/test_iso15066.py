@@ -3,26 +3,27 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pinocchio as pin
 import pytest
 
-from cellstress.cell.load import load_cell
+from cellstress.cell.load import load_cell, with_criterion
 from cellstress.core.errors import CellstressError
-from cellstress.criteria import ContactWhileMoving, criterion_for, with_criterion
+from cellstress.core.records import Measures
+from cellstress.criteria.contact import ContactWhileMoving
 from cellstress.criteria.iso15066 import (
     REGIONS,
     Iso15066,
     IsoReward,
-    body_region,
     peak_force,
-    point_dynamics,
-    reflected_mass,
     region_force,
     transient_limit,
 )
 from cellstress.human.actions import action_index
+from cellstress.human.regions import body_region
+from cellstress.robot.dynamics import point_dynamics, reflected_mass
 from cellstress.sim import kernels as K
 from cellstress.sim.determinism import check_determinism
 from cellstress.sim.scene import body_pose
@@ -41,7 +42,7 @@ def test_force_formula_against_a_hand_computed_example():
     f = region_force("chest", 0.5, 20.0)
     assert f == pytest.approx(288.675, abs=1e-3)
     assert transient_limit("chest") == 280.0
-    assert Iso15066().judge("chest", f, moving=True)[0]
+    assert Iso15066().rule("chest", f, moving=True)[0]
     # an immovable robot (infinite mass): mu = m_H
     assert peak_force(2.0, math.inf, 0.6, 75_000.0) == pytest.approx(2.0 * math.sqrt(45_000.0))
     assert peak_force(-1.0, 5.0, 0.6, 75_000.0) == 0.0  # moving apart: no impact
@@ -93,7 +94,7 @@ def test_hand_contact_at_low_speed_is_safe_under_iso_but_not_under_the_paper():
     # the predicates alone: a hand touched at 0.3 m/s by a 10 kg robot
     f = region_force("hands", 0.3, 10.0)
     assert f < transient_limit("hands")
-    assert not Iso15066().judge("hands", f, moving=True)[0]
+    assert not Iso15066().rule("hands", f, moving=True)[0]
     assert ContactWhileMoving().is_unsafe(0.0, 0.3)
     # and in the simulator: the S3 witness reaches the robot's forearm with the hand at about 0.6 m/s
     paper = Simulator("s3-fence-gap").run(S3_WITNESS)
@@ -104,17 +105,17 @@ def test_hand_contact_at_low_speed_is_safe_under_iso_but_not_under_the_paper():
     touching = [r for r in trace.rows if r[K.M_D] <= 0.0]
     assert touching  # the same contact happens, it is just not unsafe
     for r in touching:
-        c = iso.forces.assess(r)
+        c = iso.verdict(r)
         assert c.touching and c.moving and c.region == "hands"
         assert 0.0 < c.force < c.limit == 280.0 and not c.unsafe
 
 
 def test_head_contact_while_moving_is_unsafe_at_any_force():
     crit = Iso15066()
-    assert crit.judge("face", 1.0, moving=True) == (True, "face contact while the robot moves")
-    assert crit.judge("skull-forehead", 0.0, moving=True)[0]
-    assert not crit.judge("skull-forehead", 0.0, moving=False)[0]
-    assert not crit.judge("neck", 10.0, moving=True)[0]
+    assert crit.rule("face", 1.0, moving=True) == (True, "face contact while the robot moves")
+    assert crit.rule("skull-forehead", 0.0, moving=True)[0]
+    assert not crit.rule("skull-forehead", 0.0, moving=False)[0]
+    assert not crit.rule("neck", 10.0, moving=True)[0]
 
 
 def test_body_regions():
@@ -148,7 +149,7 @@ def test_body_regions():
 def test_criterion_choice_and_errors():
     cell = load_cell("s3-fence-gap")
     iso = with_criterion(cell, "iso15066")
-    assert criterion_for(iso.spec.criterion) == Iso15066(0.0, 0.001, 2.0)
+    assert iso.spec.criterion == Iso15066(distance_tolerance=0.0, speed_tolerance=0.001, payload=2.0)
     assert with_criterion(cell, None) is cell and with_criterion(cell, "contact-while-moving") is cell
     with pytest.raises(CellstressError, match="unknown criterion 'force'"):
         with_criterion(cell, "force")
@@ -157,27 +158,31 @@ def test_criterion_choice_and_errors():
 def test_reward_guards():
     r = IsoReward(8)
     # a stopped robot is worth nothing, however close (no stalling to farm reward)
-    assert r(0.0, 0.0, 0.0, False, False) == (0.0, 0.0)
+    assert r(Measures(0.0, 0.0, 0.0), False, False) == (0.0, 0.0)
     # risk grows with the force ratio, and is capped at 2 while safe
     lo, hi = r.risk(0.5, 0.5, 0.2, False), r.risk(0.5, 0.5, 0.8, False)
     assert 0.0 < lo < hi < 2.0 and r.risk(0.0, 100.0, 5.0, False) < 2.0
     # an unsafe end beats any safe episode: 2 n > 2 (n - 1)
-    assert r(0.0, 0.5, 1.2, False, True) == (16.0, 2.2)
+    assert r(Measures(0.0, 0.5, 1.2), False, True) == (16.0, 2.2)
     assert 7 * 2.0 < 16.0
-    ret_last, _ = r(3.0, 0.2, 0.0, True, False)
+    ret_last, _ = r(Measures(3.0, 0.2, 0.0), True, False)
     assert ret_last < 0.0
 
 
 class _Strict(Iso15066):
     """A test criterion with a 50 N limit everywhere, so that the S3 cell has iso15066 hazards."""
 
-    def judge(self, region, force, moving):
+    def rule(self, region, force, moving):
         return (force > 50.0, "test") if force > 50.0 else (False, None)
 
 
+def _strict_s3() -> Simulator:
+    cell = load_cell("s3-fence-gap")
+    return Simulator(replace(cell, spec=cell.spec.model_copy(update={"criterion": _Strict()})))
+
+
 def test_simulator_applies_the_criterion_the_same_way_everywhere():
-    sim = Simulator(with_criterion(load_cell("s3-fence-gap"), "iso15066"))
-    sim.forces.crit = _Strict()
+    sim = _strict_s3()
     trace = sim.run(S3_WITNESS)
     assert trace.unsafe and trace.rows[-1, K.M_UNSAFE] == 1.0 and trace.unsafe_row == len(trace.rows) - 1
     rng = np.random.default_rng(5)
@@ -194,7 +199,7 @@ def test_contact_point_velocity_matches_the_kernel_kinematics():
     from cellstress.sim import scene
 
     sim = Simulator(with_criterion(load_cell("s3-fence-gap"), "iso15066"))
-    P, fm = sim.params, sim.forces
+    P, fm = sim.params, sim.contacts
     rows = [r for r in sim.run(S3_WITNESS).rows if r[K.M_D] <= 0.0]
     assert rows
     W = K.make_work(P)
@@ -220,8 +225,7 @@ def test_a_criterion_step_inside_an_action_leaves_the_state_of_that_step():
     """When the criterion ends the episode before an action's last 50 ms step, Simulator.step returns the state
     of that step: its clock and pose are the unsafe row's, and measuring it again (the kernel's own
     sense_and_measure, which also latches stops) reproduces that row and latches nothing new."""
-    sim = Simulator(with_criterion(load_cell("s3-fence-gap"), "iso15066"))
-    sim.forces.crit = _Strict()
+    sim = _strict_s3()
     P = sim.params
     rng = np.random.default_rng(11)
     mid_action = 0

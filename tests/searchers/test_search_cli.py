@@ -86,7 +86,7 @@ def test_replay_without_hazard_or_file_is_a_user_error(tmp_path, capsys) -> None
 @pytest.mark.parametrize(
     "extra,words",
     [
-        (["--searcher", "annealing"], ["unknown searcher 'annealing'", "random, mcts, mcts-commit"]),
+        (["--searcher", "annealing"], ["unknown searcher 'annealing'", "evolve, mcts, mcts-commit, plan, random"]),
         (["--budget", "0"], ["budget", ">= 1"]),
         (["--seed", "-1"], ["seed", ">= 0"]),
         (["--until", "never"], ["until", "first, budget"]),

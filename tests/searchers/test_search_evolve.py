@@ -10,11 +10,11 @@ import pytest
 from toywalk import ToyWalk
 
 from cellstress.cli import main
-from cellstress.criteria import ContactWhileMoving
-from cellstress.searchers import SEARCHERS, Evolve, SearchError, run_search
-from cellstress.searchers.common import Reward
+from cellstress.criteria.contact import ContactWhileMoving
+from cellstress.searchers import SearchError, run_search, searcher_class
+from cellstress.searchers.evolve import Evolve
 
-REWARD = Reward(ContactWhileMoving())
+REWARD = ContactWhileMoving().reward(8)
 SEEDS = range(15)
 
 
@@ -24,7 +24,7 @@ def episodes_to_hazard(searcher: str, seed: int, budget: int, **options) -> int:
 
 
 def test_registered_for_the_campaign() -> None:
-    assert SEARCHERS["evolve"] is Evolve
+    assert searcher_class("evolve") is Evolve
     assert Evolve().name == "evolve"
 
 
@@ -90,14 +90,13 @@ def test_focus_still_beats_random() -> None:
 
 
 def test_lookahead_search_on_a_cell_is_a_pure_function_of_its_seed() -> None:
-    from cellstress.searchers.common import SimProblem
     from cellstress.sim.simulator import Simulator
 
     sim = Simulator("s2-elbow-intrusion")
-    reward = Reward(sim.criterion)
-    runs = [run_search(SimProblem(sim), reward, "evolve", 40, seed, until="budget", score="all")
+    reward = sim.criterion.reward(sim.actions_per_episode)
+    runs = [run_search(sim, reward, "evolve", 40, seed, until="budget", score="all")
             for seed in (1, 1, 2)]
-    plain = run_search(SimProblem(sim), reward, "evolve", 40, 1, until="budget")
+    plain = run_search(sim, reward, "evolve", 40, 1, until="budget")
     assert runs[0] == runs[1]
     assert runs[0].risks != runs[2].risks
     assert runs[0].episodes == 40 and len(runs[0].top) == 10

@@ -12,10 +12,9 @@ from toywalk import ToyWalk
 
 from cellstress.cell.load import builtin_text, safe_load_yaml
 from cellstress.cli import main
-from cellstress.criteria import ContactWhileMoving
-from cellstress.searchers import SEARCHERS, Plan, SearchError, run_search
-from cellstress.searchers.common import Reward, SimProblem
-from cellstress.searchers.plan import _Model
+from cellstress.criteria.contact import ContactWhileMoving
+from cellstress.searchers import SearchError, run_search, searcher_class
+from cellstress.searchers.plan import Plan, _Model
 from cellstress.sim import kernels as K
 from cellstress.sim.simulator import Simulator
 
@@ -28,16 +27,16 @@ def sims():
 
 
 def test_registered() -> None:
-    assert SEARCHERS["plan"] is Plan and Plan().name == "plan"
+    assert searcher_class("plan") is Plan and Plan().name == "plan"
 
 
 @pytest.mark.parametrize("cell", FLAWED)
 def test_finds_every_hazard_in_few_episodes(sims, cell) -> None:
     sim = sims[cell]
-    reward = Reward(sim.criterion)
+    reward = sim.criterion.reward(sim.actions_per_episode)
     episodes = []
     for seed in range(5):
-        out = run_search(SimProblem(sim), reward, "plan", 200, seed)
+        out = run_search(sim, reward, "plan", 200, seed)
         assert out.found, (cell, seed)
         ep = out.first_hazard
         assert sim.run(list(ep.actions)).unsafe  # the hazard replays from s0 by its actions alone
@@ -49,14 +48,14 @@ def test_finds_every_hazard_in_few_episodes(sims, cell) -> None:
 @pytest.mark.parametrize("budget", [1, 2, 3, 17])
 def test_budget_is_exact(budget) -> None:
     sim = Simulator("baseline")  # safe: the whole budget is used
-    out = run_search(SimProblem(sim), Reward(sim.criterion), "plan", budget, 0)
+    out = run_search(sim, sim.criterion.reward(sim.actions_per_episode), "plan", budget, 0)
     assert out.episodes == budget and len(out.risks) == budget and not out.found
 
 
 def test_until_budget_never_replays_a_hazard(sims) -> None:
     # a candidate that begins with a sequence cut short by a hazard would replay that episode: never drawn
     sim = sims["s3-fence-gap"]
-    out = run_search(SimProblem(sim), Reward(sim.criterion), "plan", 60, 1, until="budget")
+    out = run_search(sim, sim.criterion.reward(sim.actions_per_episode), "plan", 60, 1, until="budget")
     actions = [h.actions for h in out.hazards]
     assert len(actions) > 30 and len(set(actions)) == len(actions)  # measured: 57 hazards, all distinct
     assert not any(a[: len(b)] == b for a in actions for b in actions if len(b) < len(a))
@@ -64,8 +63,8 @@ def test_until_budget_never_replays_a_hazard(sims) -> None:
 
 def test_same_seed_same_search(sims) -> None:
     sim = sims["s2-elbow-intrusion"]
-    reward = Reward(sim.criterion)
-    a, b, c = (run_search(SimProblem(sim), reward, "plan", 30, s, until="budget") for s in (3, 3, 4))
+    reward = sim.criterion.reward(sim.actions_per_episode)
+    a, b, c = (run_search(sim, reward, "plan", 30, s, until="budget") for s in (3, 3, 4))
     assert a == b and a.episodes == 30
     assert a.risks != c.risks
 
@@ -80,7 +79,7 @@ def test_result_file_is_byte_identical(tmp_path, capsys) -> None:
 
 def test_refuses_what_it_cannot_search(tmp_path, capsys) -> None:
     with pytest.raises(SearchError, match="cell's simulator"):
-        run_search(ToyWalk(), Reward(ContactWhileMoving()), "plan", 20, 0)
+        run_search(ToyWalk(), ContactWhileMoving().reward(8), "plan", 20, 0)
     # several start points: one line, exit 2
     code = main(["search", "all-flaws", "--searcher", "plan", "--budget", "20", "--out", str(tmp_path / "af")])
     err = capsys.readouterr().err

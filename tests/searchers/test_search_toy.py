@@ -7,15 +7,17 @@ import statistics
 import pytest
 from toywalk import ToyWalk
 
-from cellstress.criteria import ContactWhileMoving
-from cellstress.searchers import SEARCHERS, SearchError, make_searcher, run_search
-from cellstress.searchers.common import Recorder, Reward
+from cellstress.core.records import Measures
+from cellstress.criteria.contact import ContactWhileMoving
+from cellstress.searchers import SearchError, make_searcher, run_search, searcher_class, searcher_names
+from cellstress.searchers.common import Recorder
 from cellstress.searchers.tree import Tree
 
-REWARD = Reward(ContactWhileMoving())
+REWARD = ContactWhileMoving().reward(8)
 SEEDS = range(15)
-# every searcher but plan, which needs a cell's simulator (its budget and seed tests: test_search_plan.py)
-TOY_SEARCHERS = [name for name in SEARCHERS if name != "plan"]
+# every searcher whose needs the toy meets (plan needs a cell's worker model: its tests are test_search_plan.py)
+TOY_SEARCHERS = [name for name in searcher_names()
+                 if all(isinstance(ToyWalk(), need) for need in searcher_class(name).needs)]
 
 
 def episodes_to_hazard(searcher: str, seed: int, budget: int, **options) -> int:
@@ -25,12 +27,12 @@ def episodes_to_hazard(searcher: str, seed: int, budget: int, **options) -> int:
 
 def test_toy_reward_is_the_papers() -> None:
     # d = 5 m, v = 1 m/s: c_S = 26 / e
-    r, risk = REWARD(5.0, 1.0, False, False)
+    r, risk = REWARD(Measures(5.0, 1.0), False, False)
     assert r == pytest.approx(2.718281828 / 26) and risk == r
-    r, _ = REWARD(5.0, 1.0, True, False)
+    r, _ = REWARD(Measures(5.0, 1.0), True, False)
     assert r == pytest.approx(-26 / 2.718281828)
-    r, _ = REWARD(5.0, 0.0, True, False)  # far away at the end: about -26
-    r, risk = REWARD(0.0, 1.0, True, True)  # an unsafe end is rewarded like any step (no bonus)
+    r, _ = REWARD(Measures(5.0, 0.0), True, False)  # far away at the end: about -26
+    r, risk = REWARD(Measures(0.0, 1.0), True, True)  # an unsafe end is rewarded like any step (no bonus)
     assert r == pytest.approx(2.718281828) and risk == r
 
 

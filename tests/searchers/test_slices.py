@@ -11,15 +11,16 @@ import pytest
 import yaml
 from toywalk import ToyWalk
 
-from cellstress.criteria import ContactWhileMoving
+from cellstress.criteria.contact import ContactWhileMoving
 from cellstress.human.actions import action_index
-from cellstress.searchers import Evolve, run_search, search
-from cellstress.searchers.common import Reward
-from cellstress.searchers.multistart import MultiStartProblem, start_sim
+from cellstress.searchers import run_search, search
+from cellstress.searchers.evolve import Evolve
+from cellstress.searchers.multistart import MultiStartProblem
 from cellstress.searchers.slices import ClassRecorder, Start, run_slices
 from cellstress.sim.simulator import Simulator
+from cellstress.sim.starts import start_simulator
 
-REWARD = Reward(ContactWhileMoving())
+REWARD = ContactWhileMoving().reward(8)
 
 
 class ForkWalk(ToyWalk):
@@ -126,8 +127,8 @@ def af():
 def test_start_points_carry_their_robot_phase(af, tmp_path):
     starts = {s.name: s for s in af.cell.spec.human.starts}
     assert starts["upper-end"].phase == 4.75 and starts["lower-end"].phase is None
-    assert start_sim(af, starts["lower-end"]).phase == af.phase == 2.75
-    up = start_sim(af, starts["upper-end"])
+    assert start_simulator(af, starts["lower-end"]).phase == af.phase == 2.75
+    up = start_simulator(af, starts["upper-end"])
     assert up.phase == 4.75 and af.phase == 2.75  # the cell's simulator is unchanged
     # a start's phase is exactly the cell with that robot phase and that start pose
     doc = yaml.safe_load(resources.files("cellstress.cell").joinpath("builtin", "all-flaws.yaml").read_text())

@@ -4,12 +4,15 @@ The walker stands at x = 0. Playing ``secret[x]`` moves it one step on (x + 1); 
 one step back (not below 0). Reaching x = len(secret) is the unsafe state. Metrics as the cell simulator's:
 d_HR = ``spacing`` x the remaining steps (0.25 m, so that returns spread about as on the reference cells) and
 v_R = 1 m/s, so the reward 1/c_S = e / (d^2 + 1) grows as the walker gets closer. It has the interface the
-searchers use: reset / step / is_unsafe / metrics, n_actions, actions_per_episode.
+searchers use (``core.protocols.Simulator``): reset / step / is_unsafe / measures / run, n_actions,
+actions_per_episode.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from cellstress.core.records import Measures
 
 
 class ToyWalk:
@@ -38,5 +41,24 @@ class ToyWalk:
         return state[1]
 
     @staticmethod
-    def metrics(rows):
-        return float(rows[-1, 0]), float(rows[-1, 1])
+    def measures(rows) -> Measures:
+        return Measures(float(rows[-1, 0]), float(rows[-1, 1]))
+
+    def run(self, actions) -> ToyTrace:
+        state, rows = self.reset(), []
+        for a in actions:
+            state, r = self.step(state, int(a))
+            rows.append(r)
+            if state[1]:
+                break
+        return ToyTrace(np.concatenate(rows) if rows else np.zeros((0, 2)), state[1])
+
+
+class ToyTrace:
+    def __init__(self, rows, unsafe: bool):
+        self.rows = rows
+        self.unsafe = bool(unsafe)
+
+    @property
+    def unsafe_row(self) -> int | None:
+        return len(self.rows) - 1 if self.unsafe else None

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from cellstress.core.protocols import Lookahead as LookaheadAbility
 from cellstress.human.actions import action_index
 from cellstress.sim import kernels as K
 from cellstress.sim.lookahead import Lookahead, default_horizon
@@ -92,15 +93,14 @@ def test_lookahead_leaves_the_simulator_alone() -> None:
     assert (g <= rows1[:, K.M_D] + 1e-12).all()
 
 
-def test_problem_and_simulator_expose_it() -> None:
-    from cellstress.searchers.common import SimProblem
-
+def test_the_simulator_exposes_it() -> None:
     sim = Simulator("s2-elbow-intrusion")
     state, rows = sim.step(sim.reset(), action_index("walk+upright"))
     direct = Lookahead(sim.params, 0.3, 1.0).gaps(rows, state[K.S_TSTOP])
-    np.testing.assert_array_equal(sim.lookahead(0.3, 1.0).gaps(rows, state[K.S_TSTOP]), direct)
-    np.testing.assert_array_equal(SimProblem(sim).lookahead(state, rows, 0.3, 1.0), direct)
-    assert sim.lookahead().horizon == pytest.approx(0.05 + 0.15)  # the curtain's response + stopping time
+    np.testing.assert_array_equal(sim.lookahead_model(0.3, 1.0).gaps(rows, state[K.S_TSTOP]), direct)
+    np.testing.assert_array_equal(sim.lookahead(state, rows, 0.3, 1.0), direct)
+    assert isinstance(sim, LookaheadAbility)
+    assert sim.lookahead_model().horizon == pytest.approx(0.05 + 0.15)  # the curtain's response + stopping time
 
 
 def test_bad_window() -> None:
