@@ -19,6 +19,7 @@ from pathlib import Path
 from cellstress.analysis.iso13855 import StaticCheck, check_cell
 from cellstress.cell import load
 from cellstress.cell.load import Cell
+from cellstress.core import registry
 from cellstress.report.make import ReportFiles
 from cellstress.report.make import write_report as _write_report
 from cellstress.searchers import DEFAULT_BUDGET, DEFAULT_TOP_K
@@ -27,6 +28,12 @@ from cellstress.searchers.result import SearchResult
 from cellstress.sim.simulator import Simulator, Trace
 
 CellLike = Cell | str | Path
+
+
+def make_simulator(name: str = "cell", **options) -> Simulator:
+    """A registered simulator (``cellstress.simulators`` entry points: ``cell``, the cell simulator, takes a cell;
+    ``gym`` any deterministic Gymnasium env, ``cellstress.envs.GymSimulator``), made with ``options``."""
+    return registry.load("simulators", name)(**options)
 
 
 def load_cell(path_or_name: str | Path) -> Cell:

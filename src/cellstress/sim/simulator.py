@@ -194,6 +194,21 @@ class Simulator:
                     _state_at(nxt, state, rows, self.params.dev_resp)
         return nxt, rows
 
+    def step_many(self, states: np.ndarray, actions: np.ndarray) -> np.ndarray:
+        """Play one action from each of ``states`` ((n, NS), changed in place: each becomes its next state);
+        returns the metric row of each one's last time step ((n, NM); NaN for a state that was already unsafe
+        and does not move). The same as ``step`` on each."""
+        acts = np.asarray(actions, dtype=np.int64).reshape(-1)
+        if states.ndim != 2 or states.shape != (len(acts), K.NS):
+            raise ValueError(f"states must be (n, {K.NS}) for n actions")
+        out = np.full((len(acts), K.NM), np.nan)
+        for i, a in enumerate(acts):
+            nxt, rows = self.step(states[i], int(a))
+            states[i] = nxt
+            if len(rows):
+                out[i] = rows[-1]
+        return out
+
     def first_unsafe(self, rows: np.ndarray) -> int | None:
         """Index of the first row the criterion judges unsafe (contacts only: they are rare)."""
         tol = self.criterion.distance_tolerance

@@ -1,0 +1,174 @@
+"""A cell as a Gymnasium env: the paper's worker acts, the cell's criterion rewards, the unsafe set terminates.
+
+* **Action**: ``Discrete(30)``, the worker's actions (``human.actions``: ``WALK+BODY``; one action is 0.2 s).
+* **Observation** (float64, 11 values): time [s], x, y [m], cos and sin of the heading, forward and lateral
+  flexion [rad], the robot's stop phase (0 running, 1 stop requested, 2 braking, 3 stopped), d_HR [m], v_R
+  [m/s] and the robot's path time [s], all at the action's last 50 ms step.
+* **Reward**: the cell criterion's (``Criterion.reward``): for the paper's, 1/c_S after each action and -c_S at
+  the horizon.
+* **terminated** when the episode reaches the unsafe set; **truncated** after ``actions_per_episode`` actions.
+* **info**: ``d_HR``, ``v_R``, ``risk``, ``stop_phase``, ``devices`` (the devices that see the worker),
+  ``unsafe``.
+
+The env is deterministic: ``reset``'s seed changes nothing (there is no randomness to seed), so
+``gymnasium.utils.env_checker.check_env`` passes. ``CellVectorEnv`` steps ``num_envs`` copies with one call of
+the simulator's batched step (``Simulator.step_many``); finished copies reset themselves on the next step
+(Gymnasium's next-step autoreset).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode, VectorEnv
+
+from cellstress.cell.load import Cell, load_cell, with_criterion
+from cellstress.sim import kernels as K
+from cellstress.sim.simulator import STOP_PHASES, Simulator
+from cellstress.sim.starts import start_simulator
+
+N_OBS = 11
+
+
+def _simulator(cell: str | Path | Cell, criterion: str | None, start: str | None) -> Simulator:
+    c = cell if isinstance(cell, Cell) else load_cell(cell)
+    sim = Simulator(with_criterion(c, criterion))
+    if start is None:
+        return sim
+    for s in c.spec.human.starts:
+        if s.name == start:
+            return start_simulator(sim, s)
+    known = ", ".join(s.name for s in c.spec.human.starts) or "none"
+    raise ValueError(f"unknown start {start!r} (the cell's starts: {known})")
+
+
+def observation_space(sim: Simulator) -> spaces.Box:
+    """The bounds of every observation of this cell (see the module docstring). d_HR and v_R get sound bounds:
+    no robot point is further from the base than the chain's length L (joint offsets and capsule ends), so
+    d_HR <= the floor's diagonal + |base to floor| + L, and v_R <= L times the sum of the joint speed limits
+    (the path never exceeds a joint's limit)."""
+    fl, hs, lay = sim.cell.spec.floor, sim.cell.spec.human, sim.layout
+    t_max = sim.dt * sim.steps_per_action * sim.actions_per_episode
+    fwd, lat = np.deg2rad(hs.max_forward_flexion_deg), np.deg2rad(hs.max_lateral_flexion_deg)
+    P = sim.params
+    reach = float(np.linalg.norm(P.placements[:, :3, 3], axis=1).sum()
+                  + max(np.linalg.norm(np.r_[P.cap_a, P.cap_b], axis=1).max(initial=0.0) + P.cap_r.max(initial=0.0),
+                        0.0))
+    bx, by, bz = P.base[:3, 3]
+    corner = max(np.hypot(x - bx, y - by) for x in (fl.xmin, fl.xmax) for y in (fl.ymin, fl.ymax))
+    d_max = float(np.hypot(corner, abs(bz) + 3.0) + reach)
+    v_max = float(reach * np.abs(lay.robot.velocity_limits).sum())
+    low = np.array([0.0, fl.xmin, fl.ymin, -1.0, -1.0, 0.0, -lat, 0.0, 0.0, 0.0, 0.0])
+    high = np.array([t_max, fl.xmax, fl.ymax, 1.0, 1.0, fwd, lat, 3.0, d_max, v_max, sim.phase + t_max])
+    return spaces.Box(low, high, dtype=np.float64)
+
+
+def observe(row: np.ndarray) -> np.ndarray:
+    """The observation of one metric row."""
+    h = row[K.M_HEADING]
+    return np.array([row[K.M_T], row[K.M_X], row[K.M_Y], np.cos(h), np.sin(h), row[K.M_FWD], row[K.M_LAT],
+                     row[K.M_PHASE], row[K.M_D], row[K.M_V], row[K.M_TAU]], dtype=np.float64)
+
+
+class CellEnv(gymnasium.Env):
+    """One cell (a built-in name, a cell file or a ``Cell``); ``criterion`` overrides the cell's, ``start``
+    names one of the cell's ``human.starts`` (default: its ``human.start``)."""
+
+    metadata: dict[str, Any] = {"render_modes": []}
+
+    def __init__(self, cell: str | Path | Cell = "baseline", criterion: str | None = None,
+                 start: str | None = None):
+        self.sim = _simulator(cell, criterion, start)
+        self.action_space = spaces.Discrete(self.sim.n_actions)
+        self.observation_space = observation_space(self.sim)
+        self.reward_of = self.sim.criterion.reward(self.sim.actions_per_episode)
+        self._state = self.sim.reset()
+        self._played = 0
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        super().reset(seed=seed)
+        self._state = self.sim.reset()
+        self._played = 0
+        row = self.sim.initial_metrics()
+        return observe(row), self._info(row, 0.0)
+
+    def step(self, action):
+        if not self.action_space.contains(action):
+            raise ValueError(f"action {action!r} is not in {self.action_space}")
+        state, rows = self.sim.step(self._state, int(action))
+        self._state = state
+        self._played += 1
+        unsafe = self.sim.is_unsafe(state)
+        last = self._played >= self.sim.actions_per_episode
+        reward, risk = self.reward_of(self.sim.measures(rows), last, unsafe)
+        row = rows[-1]
+        return observe(row), float(reward), bool(unsafe), bool(last and not unsafe), self._info(row, risk)
+
+    def _info(self, row: np.ndarray, risk: float) -> dict[str, Any]:
+        seen = int(row[K.M_SEEN])
+        return {"d_HR": float(row[K.M_D]), "v_R": float(row[K.M_V]), "risk": float(risk),
+                "stop_phase": STOP_PHASES[int(row[K.M_PHASE])], "unsafe": bool(row[K.M_UNSAFE]),
+                "devices": [n for i, n in enumerate(self.sim.layout.device_names) if seen >> i & 1]}
+
+
+class CellVectorEnv(VectorEnv):
+    """``num_envs`` copies of a cell, stepped together (see the module docstring)."""
+
+    metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+
+    def __init__(self, num_envs: int = 1, cell: str | Path | Cell = "baseline", criterion: str | None = None,
+                 start: str | None = None):
+        self.sim = _simulator(cell, criterion, start)
+        self.num_envs = int(num_envs)
+        self.single_action_space = spaces.Discrete(self.sim.n_actions)
+        self.action_space = spaces.MultiDiscrete(np.full(self.num_envs, self.sim.n_actions))
+        self.single_observation_space = observation_space(self.sim)
+        self.observation_space = gymnasium.vector.utils.batch_space(self.single_observation_space, self.num_envs)
+        self.reward_of = self.sim.criterion.reward(self.sim.actions_per_episode)
+        self._states = np.repeat(self.sim.reset()[None, :], self.num_envs, axis=0)
+        self._played = np.zeros(self.num_envs, dtype=np.int64)
+        self._done = np.zeros(self.num_envs, dtype=bool)
+
+    def reset(self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None):
+        super().reset(seed=seed)
+        self._states[:] = self.sim.reset()
+        self._played[:] = 0
+        self._done[:] = False
+        row = self.sim.initial_metrics()
+        obs = np.repeat(observe(row)[None, :], self.num_envs, axis=0)
+        return obs, {}
+
+    def step(self, actions):
+        acts = np.asarray(actions, dtype=np.int64).reshape(self.num_envs)
+        if acts.min() < 0 or acts.max() >= self.sim.n_actions:
+            raise ValueError(f"actions must be in 0..{self.sim.n_actions - 1}")
+        s0, row0 = self.sim.reset(), self.sim.initial_metrics()
+        restart = self._done.copy()
+        self._states[restart] = s0
+        self._played[restart] = 0
+        moving = ~restart
+        rows = np.full((self.num_envs, row0.shape[0]), np.nan)
+        states = self._states[moving]
+        rows[moving] = self.sim.step_many(states, acts[moving])  # the last row of each
+        self._states[moving] = states
+        self._played[moving] += 1
+        obs = np.empty((self.num_envs, N_OBS))
+        rewards = np.zeros(self.num_envs)
+        terminated = np.zeros(self.num_envs, dtype=bool)
+        truncated = np.zeros(self.num_envs, dtype=bool)
+        horizon = self.sim.actions_per_episode
+        for i in range(self.num_envs):
+            if restart[i]:  # next-step autoreset: this step only resets the copy
+                obs[i] = observe(row0)
+                continue
+            unsafe = self.sim.is_unsafe(self._states[i])
+            last = self._played[i] >= horizon
+            rewards[i] = self.reward_of(self.sim.measures(rows[i:i + 1]), bool(last), bool(unsafe))[0]
+            terminated[i], truncated[i] = unsafe, last and not unsafe
+            obs[i] = observe(rows[i])
+        self._done = terminated | truncated
+        return obs, rewards, terminated, truncated, {}
