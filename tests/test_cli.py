@@ -168,12 +168,12 @@ def test_simulate_safe_table(capsys) -> None:
     assert len(rows) == len(trace.rows)  # one line per time step, the initial state included
     for line, rec in zip(rows, trace.records(), strict=True):
         fields = line.split()
-        assert int(fields[0]) == rec["step"]
-        assert float(fields[1]) == pytest.approx(rec["t"], abs=0.005)
-        assert float(fields[2]) == pytest.approx(rec["x"], abs=0.0005)
-        assert float(fields[3]) == pytest.approx(rec["y"], abs=0.0005)
-        assert float(fields[7]) == pytest.approx(rec["d_HR"], abs=0.0005)
-        assert rec["stop_phase"] in fields
+        assert int(fields[0]) == rec.step
+        assert float(fields[1]) == pytest.approx(rec.t, abs=0.005)
+        assert float(fields[2]) == pytest.approx(rec.x, abs=0.0005)
+        assert float(fields[3]) == pytest.approx(rec.y, abs=0.0005)
+        assert float(fields[7]) == pytest.approx(rec.d_HR, abs=0.0005)
+        assert rec.stop_phase in fields
 
 
 def test_simulate_unsafe_table(capsys, unguarded) -> None:
@@ -188,9 +188,9 @@ def test_simulate_unsafe_table(capsys, unguarded) -> None:
     last = out.strip().splitlines()[-1]
     m = UNSAFE_LINE.match(last)
     assert m, last
-    assert float(m["t"]) == pytest.approx(hit["t"], abs=1e-6)
-    assert int(m["step"]) == hit["step"]
-    assert (m["link"], m["part"]) == (hit["robot_link"], hit["body_part"])
+    assert float(m["t"]) == pytest.approx(hit.t, abs=1e-6)
+    assert int(m["step"]) == hit.step
+    assert (m["link"], m["part"]) == (hit.robot_link, hit.body_part)
     assert len(out.strip().splitlines()) == 1 + len(trace.rows) + 1
 
 

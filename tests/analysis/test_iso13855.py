@@ -11,6 +11,7 @@ import pytest
 import yaml
 
 from cellstress.analysis import iso13855 as iso
+from cellstress.analysis import plane
 from cellstress.cell.load import builtin_text, load_cell
 
 CELLS = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap")
@@ -170,9 +171,9 @@ def test_low_fence_counts_as_open(tmp_path):
 # ---- geometry on toy cases --------------------------------------------------------------------------------
 def test_open_intervals():
     covers = [((0.0, 0.0), (1.0, 0.0)), ((2.0, 0.0), (5.0, 0.0)), ((1.5, 0.1), (1.8, 0.1))]
-    assert iso._open_intervals((0.0, 0.0), (3.0, 0.0), covers) == [((1.0, 0.0), (2.0, 0.0))]
+    assert plane.open_intervals((0.0, 0.0), (3.0, 0.0), covers) == [((1.0, 0.0), (2.0, 0.0))]
     # a collinear cover lying wholly beyond the edge's end covers nothing
-    assert iso._open_intervals((0.0, 0.0), (1.0, 0.0), [((2.0, 0.0), (3.0, 0.0))]) == [((0.0, 0.0), (1.0, 0.0))]
+    assert plane.open_intervals((0.0, 0.0), (1.0, 0.0), [((2.0, 0.0), (3.0, 0.0))]) == [((0.0, 0.0), (1.0, 0.0))]
 
 
 def _zone_point(x, y, r):
@@ -182,28 +183,28 @@ def _zone_point(x, y, r):
 
 def test_arm_path_around_a_wall_end():
     segs = [((0.0, -1.0), (0.0, 1.0))]
-    walls = iso._extended_walls(segs)
-    nodes = iso._detour_nodes(segs)
+    walls = plane.extended_walls(segs)
+    nodes = plane.detour_nodes(segs)
     assert len(nodes) == 2  # one beyond each free end
     za, zb, zr = _zone_point(1.0, 0.0, 0.1)
-    g, gi = iso._node_values(nodes, za, zb, zr, walls)
-    d, _ = iso._arm_path(-1.0, 0.0, za, zb, zr, walls, nodes, g, gi, math.inf)
+    g, gi = plane.node_values(nodes, za, zb, zr, walls)
+    d, _ = plane.arm_path(-1.0, 0.0, za, zb, zr, walls, nodes, g, gi, math.inf)
     assert d == pytest.approx(2 * math.sqrt(2) - 0.1, abs=2e-3)  # around an end: sqrt 2 + sqrt 2 - r
-    d, _ = iso._arm_path(1.0, 2.0, za, zb, zr, walls, nodes, g, gi, math.inf)
+    d, _ = plane.arm_path(1.0, 2.0, za, zb, zr, walls, nodes, g, gi, math.inf)
     assert d == pytest.approx(1.9)  # in plain view: straight
 
 
 def test_no_leak_through_a_joined_corner():
     # an L: the straight line from inside through the corner point must not count as clear
     segs = [((0.0, 0.0), (2.0, 0.0)), ((0.0, 0.0), (0.0, 2.0))]
-    walls = iso._extended_walls(segs)
-    assert iso._blocked(1.0, 1.0, -1.0, -1.0, walls)
-    assert not iso._blocked(1.0, 1.0, 1.5, 0.5, walls)
-    nodes = iso._detour_nodes(segs)
+    walls = plane.extended_walls(segs)
+    assert plane.blocked(1.0, 1.0, -1.0, -1.0, walls)
+    assert not plane.blocked(1.0, 1.0, 1.5, 0.5, walls)
+    nodes = plane.detour_nodes(segs)
     assert len(nodes) == 3  # beyond both free ends and outside the corner (its 270 deg side)
     za, zb, zr = _zone_point(-1.0, -1.0, 0.0)
-    g, gi = iso._node_values(nodes, za, zb, zr, walls)
-    d, _ = iso._arm_path(1.0, 1.0, za, zb, zr, walls, nodes, g, gi, math.inf)
+    g, gi = plane.node_values(nodes, za, zb, zr, walls)
+    d, _ = plane.arm_path(1.0, 1.0, za, zb, zr, walls, nodes, g, gi, math.inf)
     # out around the end (2, 0): sqrt 2 + |(2, 0) - (-1, -1)| = 1.414 + 3.162
     assert d == pytest.approx(math.sqrt(2) + math.sqrt(10), abs=2e-3)
 
@@ -211,12 +212,12 @@ def test_no_leak_through_a_joined_corner():
 def test_t_junction_is_closed():
     # a wall along x = 0 and a short wall ending on it: a line sliding along x = 0 past the junction is blocked
     segs = [((0.0, -2.0), (0.0, 2.0)), ((-1.0, 0.0), (0.0, 0.0))]
-    walls = iso._extended_walls(segs)
-    assert iso._blocked(0.0, 1.0, 0.0, -1.0, walls)
-    assert iso._blocked(-0.5, 0.5, -0.5, -0.5, walls)
-    assert not iso._blocked(0.5, 0.5, 0.5, -0.5, walls)
+    walls = plane.extended_walls(segs)
+    assert plane.blocked(0.0, 1.0, 0.0, -1.0, walls)
+    assert plane.blocked(-0.5, 0.5, -0.5, -0.5, walls)
+    assert not plane.blocked(0.5, 0.5, 0.5, -0.5, walls)
     # no detour node at the junction: only beyond the three free ends
-    assert len(iso._detour_nodes(segs)) == 3
+    assert len(plane.detour_nodes(segs)) == 3
 
 
 def test_docs_calibration_example_runs(capsys):

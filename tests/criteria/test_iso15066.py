@@ -98,7 +98,7 @@ def test_hand_contact_at_low_speed_is_safe_under_iso_but_not_under_the_paper():
     assert ContactWhileMoving().is_unsafe(0.0, 0.3)
     # and in the simulator: the S3 witness reaches the robot's forearm with the hand at about 0.6 m/s
     paper = Simulator("s3-fence-gap").run(S3_WITNESS)
-    assert paper.unsafe and paper.record(paper.unsafe_row)["body_part"] == "left-reach"
+    assert paper.unsafe and paper.record(paper.unsafe_row).body_part == "left-reach"
     iso = Simulator(with_criterion(load_cell("s3-fence-gap"), "iso15066"))
     trace = iso.run(S3_WITNESS)
     assert not trace.unsafe

@@ -68,7 +68,7 @@ def test_contact_marker_is_at_the_contact(s3_report, s3_sim):
     assert view.unsafe and view.matches_file
     fig, ax = topview_figure(view)
     fig.canvas.draw()
-    cx, cy, _ = res.hazard["point"]
+    cx, cy, _ = res.hazard.point
     px, py = ax.transData.transform((cx, cy))
     height = fig.canvas.get_width_height()[1]
     expected = np.array([px, height - py])  # image rows run downwards
@@ -93,7 +93,7 @@ def test_contact_point_lies_on_the_drawn_robot_link(s3_report, s3_sim):
     view = episode_of(res, s3_sim)
     a, b = view.robot(view.key_row)
     names = [c.name for c in view.layout.capsules]
-    c = names.index(res.hazard["robot_link"])
-    p = np.asarray(res.hazard["point"])
+    c = names.index(res.hazard.robot_link)
+    p = np.asarray(res.hazard.point)
     t = np.clip(np.dot(p - a[c], b[c] - a[c]) / np.dot(b[c] - a[c], b[c] - a[c]), 0.0, 1.0)
     assert abs(np.linalg.norm(p - (a[c] + t * (b[c] - a[c]))) - view.capsule_radii[c]) < 1e-6

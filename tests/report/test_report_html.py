@@ -73,10 +73,10 @@ def test_account_of_a_detected_worker(s1_witness_view):
     hit = view.records[view.key_row]
     acc = account(view)
     det = view.records[view.detection_row]
-    assert det["devices"] and hit["devices"]
-    assert f"At t = {det['t']:.2f} s the worker walks into the field of the laser scanner" in " ".join(acc.details)
-    assert f"{hit['t'] - det['t']:.2f} s after detection" in acc.headline
-    assert hit["stop_phase"] in ("stop-pending", "braking")
+    assert det.devices and hit.devices
+    assert f"At t = {det.t:.2f} s the worker walks into the field of the laser scanner" in " ".join(acc.details)
+    assert f"{hit.t - det.t:.2f} s after detection" in acc.headline
+    assert hit.stop_phase in ("stop-pending", "braking")
     assert "the stop is not complete" in acc.headline
     assert len([d for d in acc.details if d.startswith("Action ")]) == len(view.actions)
 

@@ -50,21 +50,21 @@ def test_multistart_search_is_deterministic(af, searcher):
     a = search(af, searcher, 40, 3, until="budget")
     b = search(af, searcher, 40, 3, until="budget")
     assert a.to_json() == b.to_json()
-    assert all(t["actions"][0].startswith("start:") for t in a.top)
+    assert all(t.actions[0].startswith("start:") for t in a.top)
     assert "distinct" not in a.to_dict()
 
 
 def test_distinct_mode_lists_each_class_once_with_a_replay(af):
     res = search(af, "mcts", 400, 0, until="budget", distinct=True)
     assert res.distinct, "expected at least one hazard class in 400 episodes"
-    keys = [tuple(map(str, d["class"].values())) for d in res.distinct]
+    keys = [tuple(map(str, d.klass.model_dump().values())) for d in res.distinct]
     assert len(set(keys)) == len(keys)
-    assert [d["episode"] for d in res.distinct] == sorted(d["episode"] for d in res.distinct)
+    assert [d.episode for d in res.distinct] == sorted(d.episode for d in res.distinct)
     for d in res.distinct:
-        trace = af.run(d["actions"])
+        trace = af.run(d.actions)
         assert trace.unsafe
         hit = trace.records()[trace.unsafe_row]
-        assert (hit["step"], hit["robot_link"]) == (d["step"], d["class"]["robot_link"])
+        assert (hit.step, hit.robot_link) == (d.step, d.klass.robot_link)
     assert len(res.hazards) >= len(res.distinct)
 
 

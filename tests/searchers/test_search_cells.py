@@ -36,26 +36,26 @@ def test_searchers_find_the_hazard(sims, cell, searcher, tmp_path, capsys) -> No
     res = search(sim, searcher, budget=200, seed=SEEDS.get((cell, searcher), 0))
     assert res.found, f"{searcher} found no hazard in {cell} within 200 episodes"
     h = res.hazard
-    assert 1 <= h["episode"] == res.episodes <= 200
+    assert 1 <= h.episode == res.episodes <= 200
     assert len(res.risk_per_episode) == res.episodes
-    assert res.hazards == [{"episode": h["episode"], "actions": h["actions"]}]
-    assert 1 <= len(h["actions"]) <= sim.actions_per_episode
-    last = h["trace"][-1]
-    assert last["unsafe"] and not any(r["unsafe"] for r in h["trace"][:-1])
-    assert h["d_HR"] == last["d_HR"] <= 0.0 and h["v_R"] == last["v_R"] > 0.001
-    assert h["step"] == last["step"] and h["time_s"] == last["t"]
-    assert (h["robot_link"], h["body_part"], h["point"]) == (last["robot_link"], last["body_part"],
-                                                            last["robot_point"])
+    assert [(e.episode, e.actions) for e in res.hazards] == [(h.episode, h.actions)]
+    assert 1 <= len(h.actions) <= sim.actions_per_episode
+    last = h.trace[-1]
+    assert last.unsafe and not any(r.unsafe for r in h.trace[:-1])
+    assert h.d_HR == last.d_HR <= 0.0 and h.v_R == last.v_R > 0.001
+    assert h.step == last.step and h.time_s == last.t
+    assert (h.robot_link, h.body_part, h.point) == (last.robot_link, last.body_part,
+                                                            last.robot_point)
     # the episode's risk (max 1/c_S over its action ends) is at least that of the contact, e^{v_R}
-    assert res.risk_per_episode[-1] >= np.exp(h["v_R"]) * (1 - 1e-12)
+    assert res.risk_per_episode[-1] >= np.exp(h.v_R) * (1 - 1e-12)
     # the hazard is played from s0 by its actions alone (and the last action is the unsafe one)
-    trace = sim.run(h["actions"])
+    trace = sim.run(h.actions)
     assert trace.unsafe and trace.unsafe_row == len(trace.rows) - 1
-    assert (len(trace.rows) - 2) // sim.steps_per_action == len(h["actions"]) - 1
+    assert (len(trace.rows) - 2) // sim.steps_per_action == len(h.actions) - 1
     path = res.write(tmp_path)
     assert main(["replay", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "REPRODUCED bit-exactly" in out and h["robot_link"] in out.splitlines()[-1]
+    assert "REPRODUCED bit-exactly" in out and h.robot_link in out.splitlines()[-1]
 
 
 def test_result_file_contents(sims, tmp_path) -> None:
@@ -92,12 +92,12 @@ def test_until_budget_records_every_hazard(sims, searcher) -> None:
     res = search(sims["s3-fence-gap"], searcher, budget=200, seed=0, until="budget")
     assert res.episodes == 200 == len(res.risk_per_episode)
     assert len(res.hazards) > 1
-    assert res.hazard["episode"] == res.hazards[0]["episode"]
+    assert res.hazard.episode == res.hazards[0].episode
     first = search(sims["s3-fence-gap"], searcher, budget=200, seed=0)
-    assert first.episodes == res.hazards[0]["episode"]
+    assert first.episodes == res.hazards[0].episode
     assert first.risk_per_episode == res.risk_per_episode[:first.episodes]
     for h in res.hazards[:5]:
-        assert sims["s3-fence-gap"].run(h["actions"]).unsafe
+        assert sims["s3-fence-gap"].run(h.actions).unsafe
 
 
 @pytest.mark.parametrize("budget", [1, 13, 77])

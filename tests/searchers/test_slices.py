@@ -161,18 +161,18 @@ def test_evolve_distinct_on_all_flaws_finds_all_three_flaws_and_replays(af):
     res = search(af, "evolve", 700, 0, until="budget", distinct=True)
     again = search(af, "evolve", 700, 0, until="budget", distinct=True)
     assert res.to_json() == again.to_json()
-    found = {(d["actions"][0], d["class"]["device"]) for d in res.distinct}
+    found = {(d.actions[0], d.klass.device) for d in res.distinct}
     assert {("start:upper-end", "front-scanner"), ("start:lower-end", "bay-curtain"),
             ("start:lower-end-right", "none")} <= found
-    keys = [tuple(map(str, d["class"].values())) for d in res.distinct]
+    keys = [tuple(map(str, d.klass.model_dump().values())) for d in res.distinct]
     assert len(set(keys)) == len(keys)
     for d in res.distinct:
-        trace = af.run(d["actions"])
-        assert trace.unsafe and trace.records() == d["trace"]
-    assert res.episodes == 700 and res.hazard["episode"] == res.distinct[0]["episode"]
+        trace = af.run(d.actions)
+        assert trace.unsafe and trace.records() == d.trace
+    assert res.episodes == 700 and res.hazard.episode == res.distinct[0].episode
 
 
 def test_plain_evolve_is_unchanged_by_the_hook(af):
     """Without --distinct evolve runs as before: one search over the multi-start problem."""
     res = search(af, "evolve", 120, 2, until="budget")
-    assert res.distinct is None and all(t["actions"][0].startswith("start:") for t in res.top)
+    assert res.distinct is None and all(t.actions[0].startswith("start:") for t in res.top)

@@ -29,15 +29,15 @@ def test_witness_reaches_unsafe_state(cell):
     trace = Simulator(cell).run(actions.split(","))
     assert trace.unsafe
     hit = trace.record(trace.unsafe_row)
-    assert hit["step"] == step
-    assert hit["robot_link"] == link
-    assert hit["body_part"] == part
-    assert hit["d_HR"] == 0.0
-    assert hit["v_R"] > 0.01  # ten times the standstill tolerance: moving, not a rounding artefact
-    assert hit["stop_phase"] != "stopped"
-    assert hit["devices"] == devices
+    assert hit.step == step
+    assert hit.robot_link == link
+    assert hit.body_part == part
+    assert hit.d_HR == 0.0
+    assert hit.v_R > 0.01  # ten times the standstill tolerance: moving, not a rounding artefact
+    assert hit.stop_phase != "stopped"
+    assert list(hit.devices) == devices
     # the contact points coincide at contact
-    assert max(abs(a - b) for a, b in zip(hit["robot_point"], hit["human_point"], strict=True)) < 1e-9
+    assert max(abs(a - b) for a, b in zip(hit.robot_point, hit.human_point, strict=True)) < 1e-9
 
 
 @pytest.mark.parametrize("cell", sorted(WITNESSES))

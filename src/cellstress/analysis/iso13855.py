@@ -29,56 +29,30 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from numba import njit
 
+from cellstress.analysis.hazard_zone import Closest, HazardZone, closest_on_zone, hazard_zone, segment_to_zone
+from cellstress.analysis.plane import (
+    closest_reach,
+    detour_nodes,
+    distance_to_polyline,
+    extended_walls,
+    node_values,
+    open_intervals,
+    point_segment,
+    points_in_polygon,
+    rasterise_zone,
+)
 from cellstress.cell.load import Cell, load_cell
 from cellstress.core.records import ScanPlane, VerticalField
 from cellstress.sim import kernels as K
 from cellstress.sim.build import build_layout
 
-SAMPLE_DT = 0.01  # s between robot poses when sampling the hazard zone
 GRID = 0.05  # m, flood-fill grid
 ARM_ALLOWANCE = 0.85  # m, ISO 13857 reach of the arm up to the armpit (also ISO 13855's C for body detection)
 LOW_FENCE = 1.0  # m, ISO 13857: a structure lower than this is no barrier to reaching over
-_JOIN_EXT = 1e-4  # m, panels meeting at a vertex are lengthened by this so no line slips through the joint
-_NODE_OFF = 1e-3  # m, detour nodes sit this far off a fence end or outer corner
-_COVER_TOL = 1e-6  # m, a field edge lying within this of a fence or table edge is covered by it
 
 
 # ---- records ----------------------------------------------------------------------------------------------
-@dataclass(frozen=True, eq=False)
-class HazardZone:
-    """The robot's swept floor footprint: stadiums (segment a-b inflated by r); exact repeats (the base, the
-    dwells) are kept once."""
-
-    a: np.ndarray  # (n, 2)
-    b: np.ndarray  # (n, 2)
-    r: np.ndarray  # (n,)
-    t: np.ndarray  # (n,) episode time [s] of the pose (first occurrence), in [0, cycle)
-    part: np.ndarray  # (n,) int capsule index
-    part_names: tuple[str, ...]
-    cycle: float
-    sample_dt: float
-    n_poses: int
-
-    def extent(self) -> tuple[float, float, float, float]:
-        """(xmin, xmax, ymin, ymax) of the footprint."""
-        lo = np.minimum(self.a, self.b) - self.r[:, None]
-        hi = np.maximum(self.a, self.b) + self.r[:, None]
-        return float(lo[:, 0].min()), float(hi[:, 0].max()), float(lo[:, 1].min()), float(hi[:, 1].max())
-
-
-@dataclass(frozen=True)
-class Closest:
-    """Where a distance is attained: a point on our side, the nearest point of the hazard zone, the robot
-    capsule there and the episode time [s] (modulo the cycle) at which the robot sweeps it."""
-
-    point: tuple[float, float]
-    hazard_point: tuple[float, float]
-    robot_part: str
-    t: float
-
-
 @dataclass(frozen=True)
 class DeviceCheck:
     """ISO 13855 distance of one protective device."""
@@ -157,267 +131,7 @@ class StaticCheck:
         return _lines(self)
 
 
-# ---- plane geometry (numpy) -------------------------------------------------------------------------------
-def _point_segment(px, py, ax, ay, bx, by):
-    """Distance and closest point from points p to segments ab (all broadcast)."""
-    dx, dy = bx - ax, by - ay
-    den = dx * dx + dy * dy
-    with np.errstate(invalid="ignore", divide="ignore"):
-        t = np.where(den > 1e-300, ((px - ax) * dx + (py - ay) * dy) / np.where(den > 1e-300, den, 1.0), 0.0)
-    t = np.clip(t, 0.0, 1.0)
-    qx, qy = ax + t * dx, ay + t * dy
-    return np.hypot(px - qx, py - qy), qx, qy
-
-
-def _segment_to_zone(p0, p1, zone: HazardZone, t_max: float = math.inf):
-    """Horizontal distance from segment p0-p1 to the hazard zone (only poses at t <= t_max):
-    (distance, our point, zone point, index)."""
-    sel = np.flatnonzero(zone.t <= t_max + 1e-9)
-    if len(sel) == 0:
-        return math.inf, tuple(p0), tuple(p0), -1
-    ax, ay, bx, by = zone.a[sel, 0], zone.a[sel, 1], zone.b[sel, 0], zone.b[sel, 1]
-    (x0, y0), (x1, y1) = p0, p1
-    cands = []
-    # the four endpoint-to-segment distances; each gives (d, point on p0p1, point on the zone's axis)
-    d, qx, qy = _point_segment(x0, y0, ax, ay, bx, by)
-    cands.append((d, np.full_like(d, x0), np.full_like(d, y0), qx, qy))
-    d, qx, qy = _point_segment(x1, y1, ax, ay, bx, by)
-    cands.append((d, np.full_like(d, x1), np.full_like(d, y1), qx, qy))
-    d, qx, qy = _point_segment(ax, ay, x0, y0, x1, y1)
-    cands.append((d, qx, qy, ax, ay))
-    d, qx, qy = _point_segment(bx, by, x0, y0, x1, y1)
-    cands.append((d, qx, qy, bx, by))
-    stack = np.array(cands)  # (4, 5, n)
-    k = np.argmin(stack[:, 0, :], axis=0)
-    best = stack[k, :, np.arange(len(k))]  # (n, 5)
-    # proper intersections: distance 0
-    def orient(ux, uy, vx, vy, wx, wy):
-        return (vx - ux) * (wy - uy) - (vy - uy) * (wx - ux)
-    o1, o2 = orient(x0, y0, x1, y1, ax, ay), orient(x0, y0, x1, y1, bx, by)
-    o3, o4 = orient(ax, ay, bx, by, x0, y0), orient(ax, ay, bx, by, x1, y1)
-    cross = (o1 * o2 < 0) & (o3 * o4 < 0)
-    if cross.any():
-        t = o3[cross] / (o3[cross] - o4[cross])
-        ix, iy = x0 + t * (x1 - x0), y0 + t * (y1 - y0)
-        best[cross] = np.stack([np.zeros_like(ix), ix, iy, ix, iy], axis=1)
-    rr = zone.r[sel]
-    g = best[:, 0] - rr
-    j = int(np.argmin(g))
-    dist, px, py, qx, qy = best[j]
-    # the zone's point: from the axis point towards ours by the radius
-    n = math.hypot(px - qx, py - qy)
-    if n > 0:
-        hx, hy = qx + (px - qx) * rr[j] / n, qy + (py - qy) * rr[j] / n
-    else:
-        hx, hy = qx, qy
-    return max(float(g[j]), 0.0), (float(px), float(py)), (float(hx), float(hy)), int(sel[j])
-
-
-def _closest(zone: HazardZone, point, hazard_point, i: int) -> Closest:
-    return Closest((round(point[0], 4), round(point[1], 4)), (round(hazard_point[0], 4), round(hazard_point[1], 4)),
-                   zone.part_names[int(zone.part[i])], round(float(zone.t[i]), 3))
-
-
-def _points_in_polygon(px, py, poly) -> np.ndarray:
-    inside = np.zeros(np.shape(px), dtype=bool)
-    n = len(poly)
-    for i in range(n):
-        (xi, yi), (xj, yj) = poly[i], poly[i - 1]
-        cond = (yi > py) != (yj > py)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            xc = xi + (py - yi) * (xj - xi) / (yj - yi)
-        inside ^= cond & (px < xc)
-    return inside
-
-
-def _distance_to_polyline(px, py, pts, closed: bool) -> np.ndarray:
-    best = np.full(np.shape(px), np.inf)
-    n = len(pts)
-    for i in range(n if closed else n - 1):
-        (ax, ay), (bx, by) = pts[i], pts[(i + 1) % n]
-        best = np.minimum(best, _point_segment(px, py, ax, ay, bx, by)[0])
-    return best
-
-
-# ---- plane geometry (compiled: visibility among line obstacles) --------------------------------------------
-@njit(cache=True, error_model="numpy", inline="always")
-def _orient(ax, ay, bx, by, cx, cy):
-    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
-
-
-@njit(cache=True, error_model="numpy")
-def _blocked(ax, ay, bx, by, walls):
-    """Does the straight line a-b properly cross any wall (x0, y0, x1, y1)?"""
-    for k in range(walls.shape[0]):
-        w0, w1, w2, w3 = walls[k, 0], walls[k, 1], walls[k, 2], walls[k, 3]
-        o1 = _orient(w0, w1, w2, w3, ax, ay)
-        o2 = _orient(w0, w1, w2, w3, bx, by)
-        if o1 * o2 >= 0.0:
-            continue
-        o3 = _orient(ax, ay, bx, by, w0, w1)
-        o4 = _orient(ax, ay, bx, by, w2, w3)
-        if o3 * o4 < 0.0:
-            return True
-    return False
-
-
-@njit(cache=True, error_model="numpy")
-def _direct(px, py, za, zb, zr, walls, bound):
-    """Shortest straight, unobstructed distance from p to a stadium's nearest point, if below ``bound``;
-    (distance, index), or (bound, -1)."""
-    best = bound
-    besti = -1
-    for i in range(zr.shape[0]):
-        ax, ay, bx, by = za[i, 0], za[i, 1], zb[i, 0], zb[i, 1]
-        dx, dy = bx - ax, by - ay
-        den = dx * dx + dy * dy
-        t = 0.0 if den <= 1e-300 else ((px - ax) * dx + (py - ay) * dy) / den
-        t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
-        qx, qy = ax + t * dx, ay + t * dy
-        d = np.sqrt((px - qx) ** 2 + (py - qy) ** 2)
-        g = d - zr[i]
-        if g >= best:
-            continue
-        if g <= 0.0:
-            return 0.0, i
-        # the stadium's boundary point nearest p (the line to it is all that must be clear)
-        f = g / d
-        if not _blocked(px, py, px + (qx - px) * f, py + (qy - py) * f, walls):
-            best = g
-            besti = i
-    return best, besti
-
-
-@njit(cache=True, error_model="numpy")
-def _node_values(nodes, za, zb, zr, walls):
-    """Shortest path length from every detour node to the zone (Bellman-Ford on the visibility graph)."""
-    n = nodes.shape[0]
-    g = np.full(n, np.inf)
-    gi = np.full(n, -1, dtype=np.int64)
-    for k in range(n):
-        g[k], gi[k] = _direct(nodes[k, 0], nodes[k, 1], za, zb, zr, walls, np.inf)
-    vis = np.zeros((n, n), dtype=np.bool_)
-    for k in range(n):
-        for j in range(k + 1, n):
-            if not _blocked(nodes[k, 0], nodes[k, 1], nodes[j, 0], nodes[j, 1], walls):
-                vis[k, j] = True
-                vis[j, k] = True
-    for _ in range(n):
-        changed = False
-        for k in range(n):
-            for j in range(n):
-                if vis[k, j]:
-                    c = np.sqrt((nodes[k, 0] - nodes[j, 0]) ** 2 + (nodes[k, 1] - nodes[j, 1]) ** 2) + g[j]
-                    if c < g[k] - 1e-12:
-                        g[k] = c
-                        gi[k] = gi[j]
-                        changed = True
-        if not changed:
-            break
-    return g, gi
-
-
-@njit(cache=True, error_model="numpy")
-def _arm_path(px, py, za, zb, zr, walls, nodes, g, gi, bound):
-    """Shortest path from p to the zone around the walls (straight, or via detour nodes) if below ``bound``:
-    (length, zone index), or (bound, -1)."""
-    best, bi = bound, -1
-    for k in range(nodes.shape[0]):  # the detours first: a cheap bound that spares most straight-line tests
-        c = np.sqrt((px - nodes[k, 0]) ** 2 + (py - nodes[k, 1]) ** 2) + g[k]
-        if c < best and not _blocked(px, py, nodes[k, 0], nodes[k, 1], walls):
-            best = c
-            bi = gi[k]
-    d, i = _direct(px, py, za, zb, zr, walls, best)
-    if i >= 0:
-        best, bi = d, i
-    return best, bi
-
-
-@njit(cache=True, error_model="numpy")
-def _rasterise_zone(za, zb, zr, x0, y0, h, ny, nx, grow):
-    """Cells whose centre lies within ``grow`` of the zone."""
-    occ = np.zeros((ny, nx), dtype=np.bool_)
-    for i in range(zr.shape[0]):
-        ax, ay, bx, by = za[i, 0], za[i, 1], zb[i, 0], zb[i, 1]
-        reach = zr[i] + grow
-        ix0 = max(int(np.floor((min(ax, bx) - reach - x0) / h - 0.5)), 0)
-        ix1 = min(int(np.ceil((max(ax, bx) + reach - x0) / h - 0.5)), nx - 1)
-        iy0 = max(int(np.floor((min(ay, by) - reach - y0) / h - 0.5)), 0)
-        iy1 = min(int(np.ceil((max(ay, by) + reach - y0) / h - 0.5)), ny - 1)
-        dx, dy = bx - ax, by - ay
-        den = dx * dx + dy * dy
-        for iy in range(iy0, iy1 + 1):
-            py = y0 + (iy + 0.5) * h
-            for ix in range(ix0, ix1 + 1):
-                if occ[iy, ix]:
-                    continue
-                px = x0 + (ix + 0.5) * h
-                t = 0.0 if den <= 1e-300 else ((px - ax) * dx + (py - ay) * dy) / den
-                t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
-                if (px - ax - t * dx) ** 2 + (py - ay - t * dy) ** 2 <= reach * reach:
-                    occ[iy, ix] = True
-    return occ
-
-
-@njit(cache=True, error_model="numpy")
-def _closest_reach(U, x0, y0, h, E, offs, lean_walls, za, zb, zr, arm_walls, nodes, g, gi):
-    """Over all shoulder positions p (grid cell centres) within the lean of an undetected standing cell c
-    (with c-p clear of lean_walls): the shortest arm path from p to the zone.
-
-    Cells are visited in order of E, a lower bound of their distance to the zone (hence of the path), so the
-    search stops as soon as no remaining cell can do better. Returns (distance, zone index, p cell, c cell).
-    """
-    ny, nx = U.shape
-    order = np.argsort(E)
-    best = np.inf
-    bi, bp, bc = -1, -1, -1
-    for m in range(order.shape[0]):
-        idx = order[m]
-        if E[idx] >= best:
-            break
-        iy, ix = idx // nx, idx % nx
-        px, py = x0 + (ix + 0.5) * h, y0 + (iy + 0.5) * h
-        found = -1
-        for o in range(offs.shape[0]):
-            cy, cx = iy + offs[o, 0], ix + offs[o, 1]
-            if cy < 0 or cy >= ny or cx < 0 or cx >= nx or not U[cy, cx]:
-                continue
-            if not _blocked(x0 + (cx + 0.5) * h, y0 + (cy + 0.5) * h, px, py, lean_walls):
-                found = cy * nx + cx
-                break
-        if found < 0:
-            continue
-        d, i = _arm_path(px, py, za, zb, zr, arm_walls, nodes, g, gi, best)
-        if i >= 0 and d < best:
-            best, bi, bp, bc = d, i, idx, found
-    return best, bi, bp, bc
-
-
 # ---- the cell's parts -------------------------------------------------------------------------------------
-def hazard_zone(layout, sample_dt: float = SAMPLE_DT) -> HazardZone:
-    """Sample the robot capsules over one cycle (before any stop) into floor stadiums."""
-    P = layout.params
-    W = K.make_work(P)
-    cycle = float(P.scal[K.C_CYCLE])
-    ts = np.arange(0.0, cycle, sample_dt)
-    nc = P.cap_r.shape[0]
-    ra = np.empty((len(ts), nc, 3))
-    rb = np.empty((len(ts), nc, 3))
-    for k, t in enumerate(ts):
-        K.robot_live(P, float(t), np.inf, W)
-        ra[k] = W.ra
-        rb[k] = W.rb
-    a = ra[:, :, :2].reshape(-1, 2)
-    b = rb[:, :, :2].reshape(-1, 2)
-    r = np.broadcast_to(P.cap_r, (len(ts), nc)).reshape(-1)
-    tt = np.repeat(ts, nc)
-    part = np.tile(np.arange(nc), len(ts))
-    key = np.round(np.concatenate([a, b, r[:, None]], axis=1) * 1e6).astype(np.int64)  # drops only exact repeats
-    _, first = np.unique(key, axis=0, return_index=True)
-    first = np.sort(first)
-    return HazardZone(np.ascontiguousarray(a[first]), np.ascontiguousarray(b[first]),
-                      np.ascontiguousarray(r[first]), tt[first], part[first],
-                      tuple(c.name for c in layout.capsules), cycle, sample_dt, len(ts))
 
 
 def _upright_capsule_bands(body: np.ndarray) -> list[tuple[float, float, float]]:
@@ -457,34 +171,6 @@ def lean_reach(layout) -> float:
     return best
 
 
-def _open_intervals(p0, p1, covers) -> list[tuple[tuple[float, float], tuple[float, float]]]:
-    """Parts of segment p0-p1 not lying along any of the cover segments."""
-    p0, p1 = np.asarray(p0, float), np.asarray(p1, float)
-    u = p1 - p0
-    length = float(np.hypot(*u))
-    u /= length
-    n = np.array([-u[1], u[0]])
-    spans = []
-    for a, b in covers:
-        a, b = np.asarray(a, float), np.asarray(b, float)
-        if abs((a - p0) @ n) > _COVER_TOL or abs((b - p0) @ n) > _COVER_TOL:
-            continue
-        s0, s1 = sorted(((a - p0) @ u, (b - p0) @ u))
-        s0, s1 = max(s0, 0.0), min(s1, length)
-        if s1 > s0:  # collinear covers beyond the edge's ends do not count
-            spans.append((s0, s1))
-    spans.sort()
-    out, pos = [], 0.0
-    for s0, s1 in spans:
-        if s0 > pos + _COVER_TOL:
-            out.append((pos, s0))
-        pos = max(pos, s1)
-    if pos < length - _COVER_TOL:
-        out.append((pos, length))
-    return [(tuple(round(float(v), 9) for v in p0 + s0 * u), tuple(round(float(v), 9) for v in p0 + s1 * u))
-            for s0, s1 in out if s1 - s0 > 1e-9]
-
-
 def _walk_blocking_fences(spec):
     return [(a, b) for f in spec.fences if f.bottom < K.WALK_BLOCK_HEIGHT
             for a, b in zip(f.points, f.points[1:], strict=False)]
@@ -511,11 +197,11 @@ def _device_checks(spec, zone: HazardZone) -> tuple[DeviceCheck, ...]:
         entries, best, ep = [], (math.inf, None), math.inf
         for prim in d.primitives():
             for q0, q1 in _entry_segments(prim, covers):
-                dist, p, hp, k = _segment_to_zone(q0, q1, zone)
+                dist, p, hp, k = segment_to_zone(q0, q1, zone)
                 entries.append((q0, q1, dist))
                 if dist < best[0]:
-                    best = (dist, _closest(zone, p, hp, k))
-                ep = min(ep, _segment_to_zone(q0, q1, zone, t_ep)[0])
+                    best = (dist, closest_on_zone(zone, p, hp, k))
+                ep = min(ep, segment_to_zone(q0, q1, zone, t_ep)[0])
         actual, where = best
         required = iso.S / 1000.0
         out.append(DeviceCheck(d.name, d.type, d.response_time, stop, iso.T, iso.K, iso.C, required,
@@ -529,7 +215,7 @@ def _entry_segments(prim, covers) -> list[tuple[tuple[float, float], tuple[float
     table or floor edge covers; a vertical field's line."""
     if isinstance(prim, ScanPlane):
         poly = prim.polygon
-        return [seg for i in range(len(poly)) for seg in _open_intervals(poly[i], poly[(i + 1) % len(poly)], covers)]
+        return [seg for i in range(len(poly)) for seg in open_intervals(poly[i], poly[(i + 1) % len(poly)], covers)]
     if isinstance(prim, VerticalField):
         return [(tuple(prim.start), tuple(prim.end))]
     raise TypeError(f"unknown detection primitive {type(prim).__name__}")
@@ -539,7 +225,7 @@ def _fence_panels(spec, zone: HazardZone, shoulder: float, allowance: float) -> 
     out = []
     for f in spec.fences:
         for a, b in zip(f.points, f.points[1:], strict=False):
-            dist = _segment_to_zone(a, b, zone)[0]
+            dist = segment_to_zone(a, b, zone)[0]
             over = max(f.top - shoulder, 0.0) + dist
             if f.bottom > 0.0:
                 closed, why = False, f"raised {f.bottom:.2f} m off the floor: the arm may pass under"
@@ -553,55 +239,6 @@ def _fence_panels(spec, zone: HazardZone, shoulder: float, allowance: float) -> 
                                      f"{over:.2f} m >= {allowance:.2f} m")
             out.append(FencePanel(tuple(a), tuple(b), f.top, f.bottom, dist, over, closed, why))
     return tuple(out)
-
-
-def _junctions(segments) -> dict[tuple[int, int], tuple[np.ndarray, list[float]]]:
-    """Every wall end with the directions of all walls leaving it: walls that end there, and both directions
-    of a wall that passes through it (a T-junction)."""
-    def key(p):
-        return (round(float(p[0]) * 1e6), round(float(p[1]) * 1e6))
-
-    segs = [(np.asarray(a, float), np.asarray(b, float)) for a, b in segments]
-    out: dict[tuple[int, int], tuple[np.ndarray, list[float]]] = {}
-    for a, b in segs:
-        for p, q in ((a, b), (b, a)):
-            out.setdefault(key(p), (p, []))[1].append(math.atan2(q[1] - p[1], q[0] - p[0]))
-    for p, angles in out.values():
-        for a, b in segs:
-            u = b - a
-            t = float((p - a) @ u / (u @ u))
-            if 1e-9 < t < 1 - 1e-9 and np.hypot(*(a + t * u - p)) < 1e-9:
-                angles += [math.atan2(u[1], u[0]), math.atan2(-u[1], -u[0])]
-    return out
-
-
-def _extended_walls(segments) -> np.ndarray:
-    """Walls as an (n, 4) array, each end that meets another wall lengthened by _JOIN_EXT, so that no straight
-    line slips through the joint."""
-    joints = _junctions(segments)
-    out = []
-    for a, b in segments:
-        a, b = np.asarray(a, float), np.asarray(b, float)
-        u = (b - a) / np.hypot(*(b - a))
-        if len(joints[(round(a[0] * 1e6), round(a[1] * 1e6))][1]) > 1:
-            a = a - _JOIN_EXT * u
-        if len(joints[(round(b[0] * 1e6), round(b[1] * 1e6))][1]) > 1:
-            b = b + _JOIN_EXT * u
-        out.append((*a, *b))
-    return np.asarray(out, dtype=float).reshape(-1, 4)
-
-
-def _detour_nodes(segments) -> np.ndarray:
-    """Points just off every free wall end and outer corner: where shortest paths around walls bend."""
-    nodes = []
-    for p, angles in _junctions(segments).values():
-        angles = sorted(angles)
-        for i, a0 in enumerate(angles):
-            a1 = angles[(i + 1) % len(angles)] + (2 * math.pi if i + 1 == len(angles) else 0.0)
-            if a1 - a0 > math.pi + 1e-9:  # a reflex gap between walls: paths bend around this corner
-                mid = 0.5 * (a0 + a1)
-                nodes.append((p[0] + _NODE_OFF * math.cos(mid), p[1] + _NODE_OFF * math.sin(mid)))
-    return np.asarray(nodes, dtype=float).reshape(-1, 2)
 
 
 def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowance: float) -> ApproachCheck:
@@ -618,20 +255,20 @@ def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowan
     X, Y = np.meshgrid(xs, ys)  # (ny, nx)
     ok = (X - radius >= fl.xmin) & (X + radius <= fl.xmax) & (Y - radius >= fl.ymin) & (Y + radius <= fl.ymax)
     for poly in spec.table.polygons:
-        ok &= ~_points_in_polygon(X, Y, poly) & (_distance_to_polyline(X, Y, poly, True) >= radius)
+        ok &= ~points_in_polygon(X, Y, poly) & (distance_to_polyline(X, Y, poly, True) >= radius)
     for a, b in _walk_blocking_fences(spec):
-        ok &= _point_segment(X, Y, a[0], a[1], b[0], b[1])[0] >= radius
+        ok &= point_segment(X, Y, a[0], a[1], b[0], b[1])[0] >= radius
     m_scan, m_curtain = 0.0, 0.0
     curtains = []
     for prim in (p for d in spec.devices for p in d.primitives()):
         if isinstance(prim, ScanPlane):
             m = detection_margin(body, prim.height, prim.height)
             m_scan = max(m_scan, m)
-            ok &= ~_points_in_polygon(X, Y, prim.polygon) & (_distance_to_polyline(X, Y, prim.polygon, True) > m)
+            ok &= ~points_in_polygon(X, Y, prim.polygon) & (distance_to_polyline(X, Y, prim.polygon, True) > m)
         else:
             m = detection_margin(body, prim.bottom, prim.top)
             m_curtain = max(m_curtain, m)
-            ok &= _point_segment(X, Y, prim.start[0], prim.start[1], prim.end[0], prim.end[1])[0] > m
+            ok &= point_segment(X, Y, prim.start[0], prim.start[1], prim.end[0], prim.end[1])[0] > m
             curtains.append((tuple(prim.start), tuple(prim.end)))
     sx, sy = spec.human.start.xy
     ix = min(max(int((sx - fl.xmin) / h), 0), nx - 1)
@@ -645,19 +282,19 @@ def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowan
     U = (labels == seed) if not detected else np.zeros_like(ok)
 
     walls = [(p.start, p.end) for p in panels if p.closed] + curtains
-    arm_walls = _extended_walls(walls)
-    nodes = _detour_nodes(walls)
-    g, gi = _node_values(nodes, zone.a, zone.b, zone.r, arm_walls)
+    arm_walls = extended_walls(walls)
+    nodes = detour_nodes(walls)
+    g, gi = node_values(nodes, zone.a, zone.b, zone.r, arm_walls)
     R = int(math.ceil(lean / h)) + 1
     offs = [(dy, dx) for dy in range(-R, R + 1) for dx in range(-R, R + 1) if math.hypot(dy, dx) * h <= lean]
     offs = np.asarray(sorted(offs, key=lambda o: (o[0] ** 2 + o[1] ** 2, o)), dtype=np.int64).reshape(-1, 2)
     # a lower bound of every cell's distance to the zone: cells within h/sqrt2 of it are occupied, so the zone
     # point nearest p lies within h/sqrt2 of an occupied cell's centre
     grow = h / math.sqrt(2.0)
-    occ = _rasterise_zone(zone.a, zone.b, zone.r, fl.xmin, fl.ymin, h, ny, nx, grow)
+    occ = rasterise_zone(zone.a, zone.b, zone.r, fl.xmin, fl.ymin, h, ny, nx, grow)
     E = np.maximum(ndimage.distance_transform_edt(~occ, sampling=h) - grow, 0.0).ravel() if occ.any() \
         else np.full(ny * nx, 0.0)
-    best, bi, bp, bc = _closest_reach(U, fl.xmin, fl.ymin, h, E, offs, arm_walls, zone.a, zone.b, zone.r,
+    best, bi, bp, bc = closest_reach(U, fl.xmin, fl.ymin, h, E, offs, arm_walls, zone.a, zone.b, zone.r,
                                       arm_walls, nodes, g, gi)
     where, stand = None, None
     if bp >= 0 and math.isfinite(best):
@@ -665,11 +302,11 @@ def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowan
         stand = (round(float(xs[bc % nx]), 4), round(float(ys[bc // nx]), 4))
         k = int(bi)
         # the zone point: nearest boundary point of stadium k (exact when the line is clear, else indicative)
-        hp = _point_segment(px, py, zone.a[k, 0], zone.a[k, 1], zone.b[k, 0], zone.b[k, 1])
+        hp = point_segment(px, py, zone.a[k, 0], zone.a[k, 1], zone.b[k, 0], zone.b[k, 1])
         dd = float(hp[0])
         f = (dd - zone.r[k]) / dd if dd > 0 else 0.0
         hx, hy = px + (float(hp[1]) - px) * f, py + (float(hp[2]) - py) * f
-        where = _closest(zone, (px, py), (hx, hy), k)
+        where = closest_on_zone(zone, (px, py), (hx, hy), k)
     return ApproachCheck((float(sx), float(sy)), bool(detected), float(U.sum() * h * h), lean, allowance,
                          m_scan, m_curtain, stand, float(best), where, bool(best >= allowance - 1e-9))
 

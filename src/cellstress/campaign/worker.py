@@ -85,12 +85,12 @@ def execute(spec: RunSpec) -> dict[str, Any]:
     result = search(sim, spec.searcher.name, spec.budget, spec.seed, **spec.searcher.params_dict)
     h = result.hazard
     hazard = None if h is None else {
-        "episode": h["episode"],
-        "actions": h["actions"],
-        "step": h["step"],
-        "time_s": h["time_s"],
-        "robot_link": h["robot_link"],
-        "body_part": h["body_part"],
+        "episode": h.episode,
+        "actions": list(h.actions),
+        "step": h.step,
+        "time_s": h.time_s,
+        "robot_link": h.robot_link,
+        "body_part": h.body_part,
     }
     return {
         "format": RECORD_FORMAT,

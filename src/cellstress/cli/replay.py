@@ -20,6 +20,7 @@ def replay(
 
     Exit code 0 if the replay agrees with the file, 1 if it does not."""
     from cellstress.cell.load import load_cell, with_criterion
+    from cellstress.cell.schema import DEFAULT_CRITERION
     from cellstress.core.io import json_ready
     from cellstress.searchers.result import SearchResult
     from cellstress.sim.simulator import Simulator
@@ -28,7 +29,7 @@ def replay(
         res = SearchResult.load(result_file)
     h = res.hazard
     if hazard_index is not None:
-        hs = res.distinct or []
+        hs = res.distinct or ()
         if not 0 <= hazard_index < len(hs):
             raise fail(f"--hazard {hazard_index}: the result lists {len(hs)} distinct hazards"
                        + (f" (0..{len(hs) - 1})" if hs else ""))
@@ -36,18 +37,17 @@ def replay(
     if h is None:
         raise fail(f"{result_file}: the search found no hazard; there is nothing to replay")
     with user_errors():
-        c = with_criterion(load_cell(res.cell.get("source", res.cell["name"])),
-                           res.cell.get("criterion", "contact-while-moving"))
-        trace = Simulator(c).run(h["actions"])
-    records = json_ready(trace.records())
+        c = with_criterion(load_cell(res.cell.source), res.cell.criterion or DEFAULT_CRITERION)
+        trace = Simulator(c).run(list(h.actions))
+    records = [json_ready(r.model_dump()) for r in trace.records()]
     typer.echo(HEADER)
     for r in records:
         typer.echo(step_line(r))
     problems = []
-    if c.sha256 != res.cell["sha256"]:
+    if c.sha256 != res.cell.sha256:
         problems.append(f"the cell differs from the one searched (sha256 {c.sha256[:12]} != "
-                        f"{str(res.cell['sha256'])[:12]})")
-    recorded = h["trace"]
+                        f"{res.cell.sha256[:12]})")
+    recorded = [json_ready(r.model_dump()) for r in h.trace]
     if len(records) != len(recorded):
         problems.append(f"the replay has {len(records)} rows, the file {len(recorded)}")
     for i, (a, b) in enumerate(zip(records, recorded, strict=False)):
@@ -61,5 +61,5 @@ def replay(
         for p in problems:
             typer.echo(f"MISMATCH: {p}")
         raise typer.Exit(1)
-    typer.echo(f"REPRODUCED bit-exactly: UNSAFE at t={num(h['time_s'])} s (step {h['step']}): "
-               f"{h['robot_link']} / {h['body_part']}, v_R {h['v_R']:.3f} m/s")
+    typer.echo(f"REPRODUCED bit-exactly: UNSAFE at t={num(h.time_s)} s (step {h.step}): "
+               f"{h.robot_link} / {h.body_part}, v_R {h.v_R:.3f} m/s")

@@ -112,7 +112,7 @@ def search(
                    err=True)
         return
     echo = typer.echo
-    echo(f"cell      {result.cell['name']}  searcher {result.searcher} ({_params_text(result.params)})  "
+    echo(f"cell      {result.cell.name}  searcher {result.searcher} ({_params_text(result.params)})  "
          f"seed {seed}  budget {budget}")
     best = max(result.risk_per_episode, default=0.0)
     h = result.hazard
@@ -121,16 +121,16 @@ def search(
              f"{rate:.0f} episodes/s)")
     else:
         extra_text = f", {len(result.hazards)} hazardous episodes in all" if until == "budget" else ""
-        echo(f"FOUND at episode {h['episode']} of {budget}{extra_text} ({result.episodes} episodes in "
+        echo(f"FOUND at episode {h.episode} of {budget}{extra_text} ({result.episodes} episodes in "
              f"{elapsed:.2f} s, {rate:.0f} episodes/s)")
-        echo(f"actions   {', '.join(h['actions'])}")
-        x, y, z = h["point"]
-        echo(f"contact   t={num(h['time_s'])} s (step {h['step']}): {h['robot_link']} / {h['body_part']} at "
-             f"({x:.3f}, {y:.3f}, {z:.3f}) m, robot moving at v_R {h['v_R']:.3f} m/s")
-    for i, d in enumerate(result.distinct or []):
-        cls = d["class"]
-        x0, y0, x1, y1 = cls["approach_cell"]
-        echo(f"class {i}   episode {d['episode']}: {cls['device']} / {cls['robot_link']} / {cls['body_region']} at "
+        echo(f"actions   {', '.join(h.actions)}")
+        x, y, z = h.point
+        echo(f"contact   t={num(h.time_s)} s (step {h.step}): {h.robot_link} / {h.body_part} at "
+             f"({x:.3f}, {y:.3f}, {z:.3f}) m, robot moving at v_R {h.v_R:.3f} m/s")
+    for i, d in enumerate(result.distinct or ()):
+        cls = d.klass
+        x0, y0, x1, y1 = cls.approach_cell
+        echo(f"class {i}   episode {d.episode}: {cls.device} / {cls.robot_link} / {cls.body_region} at "
              f"x {num(x0)}..{num(x1)}, y {num(y0)}..{num(y1)}  (cellstress replay {path} --hazard {i})")
     if report:
         echo(report)

@@ -31,7 +31,7 @@ def simulate(
         c = with_criterion(load_cell(cell), criterion)
         sim = Simulator(c)
         trace = sim.run(indices)
-    records = trace.records()
+    records = [r.model_dump() for r in trace.records()]
     hit = trace.unsafe_row
     hazard = None
     verdict = None

@@ -29,8 +29,8 @@ class AnimationOptions:
 
 def _region(view: EpisodeView, zone) -> tuple[float, float, float, float]:
     """Plan region to show: the worker's path, the robot's swept area and the contact, with a margin."""
-    xs = [r["x"] for r in view.records] + [view.records[view.key_row]["robot_point"][0]]
-    ys = [r["y"] for r in view.records] + [view.records[view.key_row]["robot_point"][1]]
+    xs = [r.x for r in view.records] + [view.records[view.key_row].robot_point[0]]
+    ys = [r.y for r in view.records] + [view.records[view.key_row].robot_point[1]]
     x0, x1, y0, y1 = zone.extent()
     arm = view.layout.body.arm_length + 0.3
     lo_x, hi_x = min(min(xs) - arm, x0 - 0.2), max(max(xs) + arm, x1 + 0.2)
@@ -62,7 +62,7 @@ def render_frames(view: EpisodeView, options: AnimationOptions = AnimationOption
     radii = view.capsule_radii
     h = view.layout.reach.spacing * options.reach_stride
     recs = view.records
-    path = np.array([[r["x"], r["y"]] for r in recs])
+    path = np.array([[r.x, r.y] for r in recs])
     tripped: dict[str, float] = {}
     frames = []
     # blitting: the static cell is rendered once; each frame restores it and draws only the moving artists
@@ -74,36 +74,36 @@ def render_frames(view: EpisodeView, options: AnimationOptions = AnimationOption
         artists = []
         pose = view.pose(i)
         ra, rb = view.robot(i)
-        link = names.index(r["robot_link"]) if r["robot_link"] in names else -1
+        link = names.index(r.robot_link) if r.robot_link in names else -1
         colors = [D.ROBOT_HIT if c == link else D.ROBOT for c in range(len(radii))]
         artists.append(ax.add_collection(D.capsule_patches(ra[:, :2], rb[:, :2], radii, facecolor=colors,
                                                            alpha=0.8, edgecolor="white", lw=0.4, zorder=6)))
         for side in (0, 1):
             pts = view.reach(i, side, options.reach_stride, pose)
-            main = r["body_part"] == ("left-reach", "right-reach")[side]
+            main = r.body_part == ("left-reach", "right-reach")[side]
             artists += D.draw_volume(ax, pts[:, :2], h, D.REACH, alpha=0.25, lw=1.0 if main else 0.6, zorder=7,
                                      fill=main, ls="-" if main else "--")
         artists.append(ax.add_collection(D.capsule_patches(pose.a[:, :2], pose.b[:, :2], pose.r, facecolor=D.BODY,
                                                            alpha=0.8, edgecolor="white", lw=0.4, zorder=8)))
         artists += ax.plot(path[: i + 1, 0], path[: i + 1, 1], color=D.PATH, lw=1.2, zorder=9)
-        rp, hp = r["robot_point"], r["human_point"]
+        rp, hp = r.robot_point, r.human_point
         artists += ax.plot([rp[0], hp[0]], [rp[1], hp[1]], color="black", lw=1.5, zorder=10)
-        if r["unsafe"]:
+        if r.unsafe:
             artists += ax.plot([rp[0]], [rp[1]], marker="*", ms=14, color=D.CONTACT, mec="black", zorder=11,
                                ls="none")
-        for name in r["devices"]:
-            tripped.setdefault(name, r["t"])
-        lines = [(f"t = {r['t']:.2f} s   step {r['step']} / {n_steps}", "black"),
-                 (f"action {(i - 1) // view.steps_per_action + 1}: {r['action']}" if r["action"] else "start",
+        for name in r.devices:
+            tripped.setdefault(name, r.t)
+        lines = [(f"t = {r.t:.2f} s   step {r.step} / {n_steps}", "black"),
+                 (f"action {(i - 1) // view.steps_per_action + 1}: {r.action}" if r.action else "start",
                   "black"),
                  ("", "black"),
-                 (f"d_HR = {r['d_HR']:.3f} m", "black"),
-                 (f"v_R  = {r['v_R']:.2f} m/s", "black"),
-                 (f"closest: {r['robot_link']} / {r['body_part']}", "#444444"),
+                 (f"d_HR = {r.d_HR:.3f} m", "black"),
+                 (f"v_R  = {r.v_R:.2f} m/s", "black"),
+                 (f"closest: {r.robot_link} / {r.body_part}", "#444444"),
                  ("", "black"),
                  ("devices", "black")]
         for d in spec.devices:
-            if d.name in r["devices"]:
+            if d.name in r.devices:
                 state, color = "sees the worker", "#b00000"
             elif d.name in tripped:
                 state, color = f"tripped at {tripped[d.name]:.2f} s", "#b06000"
@@ -111,11 +111,11 @@ def render_frames(view: EpisodeView, options: AnimationOptions = AnimationOption
                 state, color = "clear", "#2a7a2a"
             lines.append((f"  {d.name}: {state}", color))
         stop = stop_request(view, i)
-        phase = r["stop_phase"]
+        phase = r.stop_phase
         phase_text = {"running": "running", "stop-pending": f"stop pending (at {stop[0]:.2f} s)" if stop else
                       "stop pending", "braking": "braking", "stopped": "stopped"}.get(phase, phase)
         lines += [("", "black"), (f"robot: {phase_text}", "#b00000" if phase != "running" else "black")]
-        if r["unsafe"]:
+        if r.unsafe:
             lines += [("", "black"), ("UNSAFE: contact while moving", D.CONTACT)]
         for k, (text, color) in enumerate(lines):
             artists.append(panel.text(0.0, 1.0 - k * 0.055, text, color=color, fontsize=8.5, va="top",

@@ -134,7 +134,7 @@ class PlanStyle:
 
 def swept_footprint(layout: Layout):
     """The floor area the robot sweeps over one cycle: the ISO 13855 check's hazard zone (same sampling)."""
-    from cellstress.analysis.iso13855 import hazard_zone
+    from cellstress.analysis.hazard_zone import hazard_zone
 
     return hazard_zone(layout)
 

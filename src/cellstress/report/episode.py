@@ -19,6 +19,7 @@ from cellstress.human.actions import ACTION_NAMES, action_index
 from cellstress.searchers.result import SearchResult
 from cellstress.sim import scene
 from cellstress.sim.build import Layout
+from cellstress.sim.records import StepRecord
 from cellstress.sim.simulator import Simulator
 
 
@@ -29,7 +30,7 @@ class EpisodeView:
     layout: Layout
     start: tuple[float, float, float]  # x, y, heading [deg]
     actions: tuple[str, ...]
-    records: tuple[dict, ...]
+    records: tuple[StepRecord, ...]
     taus: np.ndarray  # robot path time per row
     episode: int | None  # the episode's number in the search (1-based), None if not from a search
     kind: str  # "hazard" (the first hazard found) or "riskiest" (no hazard: the riskiest kept episode)
@@ -37,7 +38,7 @@ class EpisodeView:
 
     @property
     def unsafe(self) -> bool:
-        return bool(self.records[-1]["unsafe"])
+        return bool(self.records[-1].unsafe)
 
     @property
     def dt(self) -> float:
@@ -58,7 +59,7 @@ class EpisodeView:
     @cached_property
     def detection_row(self) -> int | None:
         """The first row at which a device sees the worker."""
-        return next((i for i, r in enumerate(self.records) if r["devices"]), None)
+        return next((i for i, r in enumerate(self.records) if r.devices), None)
 
     def action_rows(self, k: int) -> range:
         """Rows played by action k (0-based)."""
@@ -67,8 +68,8 @@ class EpisodeView:
 
     def pose(self, i: int) -> scene.BodyPose:
         r = self.records[i]
-        return scene.body_pose(self.layout, r["x"], r["y"], math.radians(r["heading_deg"]),
-                               math.radians(r["forward_flexion_deg"]), math.radians(r["lateral_flexion_deg"]))
+        return scene.body_pose(self.layout, r.x, r.y, math.radians(r.heading_deg),
+                               math.radians(r.forward_flexion_deg), math.radians(r.lateral_flexion_deg))
 
     def robot(self, i: int) -> tuple[np.ndarray, np.ndarray]:
         return scene.robot_capsules(self.layout, float(self.taus[i]))
@@ -88,16 +89,20 @@ class EpisodeView:
         return self.layout.params.cap_r
 
 
-def risk(record: dict) -> float:
+def _json(records) -> str:
+    return json.dumps(json_ready([r.model_dump() for r in records]), sort_keys=True)
+
+
+def risk(record: StepRecord) -> float:
     """1/c_S of a step (the search's risk): exp(v_R) / (d_HR^2 + 1)."""
-    d, v = record["d_HR"], record["v_R"]
+    d, v = record.d_HR, record.v_R
     if d is None or v is None:
         return 0.0
     return math.exp(v) / (d * d + 1.0)
 
 
 def replay(sim: Simulator, actions, *, episode: int | None = None, kind: str = "hazard",
-           recorded: list[dict] | None = None) -> EpisodeView:
+           recorded: tuple[StepRecord, ...] | None = None) -> EpisodeView:
     """Play ``actions`` from the simulator's start and keep what a report needs. A leading ``start:NAME``
     (a cell with several start points) is played from that start, with its robot phase."""
     from cellstress.sim.starts import split_start
@@ -107,8 +112,7 @@ def replay(sim: Simulator, actions, *, episode: int | None = None, kind: str = "
     records = trace.records()
     matches = None
     if recorded is not None:
-        mine = json.dumps(json_ready(records), sort_keys=True)
-        matches = mine == json.dumps(recorded, sort_keys=True)
+        matches = _json(records) == _json(recorded)
     # the actions actually played: an unsafe step ends the episode and drops the actions after it
     n_played = -(-(len(records) - 1) // sim.steps_per_action)
     acts = tuple(ACTION_NAMES[action_index(a)] for a in list(actions)[:n_played])
@@ -120,8 +124,8 @@ def episode_of(result: SearchResult, sim: Simulator) -> EpisodeView:
     """The first hazard of a search; with none, the riskiest of its kept top episodes."""
     h = result.hazard
     if h is not None:
-        return replay(sim, h["actions"], episode=h.get("episode"), kind="hazard", recorded=h.get("trace"))
+        return replay(sim, h.actions, episode=h.episode, kind="hazard", recorded=h.trace)
     if not result.top:
         raise ValueError("the result holds no episode to show")
-    best = max(result.top, key=lambda e: (e["risk"] if e["risk"] is not None else -math.inf, -e["episode"]))
-    return replay(sim, best["actions"], episode=best["episode"], kind="riskiest")
+    best = max(result.top, key=lambda e: (e.risk if e.risk is not None else -math.inf, -e.episode))
+    return replay(sim, best.actions, episode=best.episode, kind="riskiest")

@@ -56,19 +56,19 @@ def _draw_episode(ax, view: EpisodeView, pose, reach: list[np.ndarray], handles:
     recs = view.records
     key = view.key_row
     hit = recs[key]
-    xy = np.array([[r["x"], r["y"]] for r in recs])
+    xy = np.array([[r.x, r.y] for r in recs])
     ax.plot(xy[:, 0], xy[:, 1], color=D.PATH, lw=1.6, zorder=9)
     ax.plot(xy[:, 0], xy[:, 1], ".", color=D.PATH, ms=3, zorder=9)
     add(Line2D([], [], color=D.PATH, lw=1.6, marker=".", ms=3, label=f"worker's path ({view.dt:g} s steps)"))
     placed: dict[tuple[int, int], int] = {}
     for k, act in enumerate(view.actions):
         r = recs[view.action_rows(k)[-1]]
-        D.draw_pose_arrow(ax, r["x"], r["y"], np.deg2rad(r["heading_deg"]), "white", size=mark_size, zorder=13)
+        D.draw_pose_arrow(ax, r.x, r.y, np.deg2rad(r.heading_deg), "white", size=mark_size, zorder=13)
         # actions ending at the same spot (turning in place, blocked) get their labels stacked, not overprinted
-        spot = (round(r["x"] / 0.1), round(r["y"] / 0.1))
+        spot = (round(r.x / 0.1), round(r.y / 0.1))
         above = placed.get(spot, 0)
         placed[spot] = above + 1
-        ax.annotate(f"{k + 1}{POSTURE_MARK.get(act.partition('+')[2], '?')}", (r["x"], r["y"]),
+        ax.annotate(f"{k + 1}{POSTURE_MARK.get(act.partition('+')[2], '?')}", (r.x, r.y),
                     xytext=(6, 4 + 8 * above), textcoords="offset points", fontsize=7, color="#0b3c6b", zorder=14)
     add(Line2D([], [], marker=">", color="white", mec="black", ls="none", ms=7,
                label="after action k: heading, posture\n(U upright, F forward, L / R left / right)"))
@@ -77,21 +77,21 @@ def _draw_episode(ax, view: EpisodeView, pose, reach: list[np.ndarray], handles:
     add(Patch(facecolor=D.BODY, alpha=0.7, label="worker's body at " + ("contact" if view.unsafe
                                                                           else "the closest call")))
     for side in (0, 1):
-        main = hit["body_part"] == ("left-reach", "right-reach")[side]
+        main = hit.body_part == ("left-reach", "right-reach")[side]
         D.draw_volume(ax, reach[side][:, :2], view.layout.reach.spacing, D.REACH, alpha=0.25 if main else 0.0,
                       lw=1.2 if main else 0.8, zorder=11, fill=main, ls="-" if main else "--")
     add(Patch(facecolor=D.REACH, alpha=0.35, edgecolor=D.REACH, label="arm reach volume (projected)"))
     det = view.detection_row
     if det is not None:
         r = recs[det]
-        ax.plot([r["x"]], [r["y"]], marker="D", ms=8, color=D.DETECT, mec="black", zorder=13, ls="none")
+        ax.plot([r.x], [r.y], marker="D", ms=8, color=D.DETECT, mec="black", zorder=13, ls="none")
         add(Line2D([], [], marker="D", ms=8, color=D.DETECT, mec="black", ls="none",
-                   label=f"first detected (t = {r['t']:.2f} s, {', '.join(r['devices'])})"))
-    cx, cy, _ = hit["robot_point"]
+                   label=f"first detected (t = {r.t:.2f} s, {', '.join(r.devices)})"))
+    cx, cy, _ = hit.robot_point
     label = "contact point" if view.unsafe else "closest point (no contact)"
     ax.plot([cx], [cy], marker="*", ms=18, color=D.CONTACT, mec="black", mew=0.8, zorder=20, ls="none")
     add(Line2D([], [], marker="*", ms=14, color=D.CONTACT, mec="black", ls="none",
-               label=f"{label} (t = {hit['t']:.2f} s)"))
+               label=f"{label} (t = {hit.t:.2f} s)"))
 
 
 INSET_AXES = (0.66, 0.07, 0.32, 0.42)  # below the legend
@@ -121,7 +121,7 @@ def topview_figure(view: EpisodeView, size: D.FigureSize = StillOptions().topvie
     _draw_episode(inset, view, pose, reach, None, mark_size=0.08)
     recs = view.records
     hit = recs[key]
-    pts = [np.array([[r["x"], r["y"]] for r in recs]), np.asarray(hit["robot_point"][:2])[None]]
+    pts = [np.array([[r.x, r.y] for r in recs]), np.asarray(hit.robot_point[:2])[None]]
     lo = np.min(np.concatenate(pts), axis=0) - 0.45
     hi = np.max(np.concatenate(pts), axis=0) + 0.45
     half = 0.5 * max(hi - lo)  # square, so the equal aspect fills the box
@@ -145,7 +145,7 @@ def _side_axis(view: EpisodeView) -> int:
     """The world axis (0 = x, 1 = y) along which the worker and the contact are furthest apart: the side
     view looks across it, so both are seen side by side rather than one behind the other."""
     hit = view.records[view.key_row]
-    d = np.abs(np.subtract(hit["robot_point"][:2], (hit["x"], hit["y"])))
+    d = np.abs(np.subtract(hit.robot_point[:2], (hit.x, hit.y)))
     return int(d[1] > d[0])
 
 
@@ -159,10 +159,10 @@ def contact_figure(view: EpisodeView, size: D.FigureSize = StillOptions().contac
     ra, rb = view.robot(key)
     radii = view.capsule_radii
     names = [c.name for c in view.layout.capsules]
-    hit_link = names.index(hit["robot_link"]) if hit["robot_link"] in names else -1
+    hit_link = names.index(hit.robot_link) if hit.robot_link in names else -1
     reach = [view.reach(key, side, REACH_STRIDE_STILL, pose) for side in (0, 1)]
-    touching = {"left-reach": 0, "right-reach": 1}.get(hit["body_part"])
-    rp, hp = np.asarray(hit["robot_point"]), np.asarray(hit["human_point"])
+    touching = {"left-reach": 0, "right-reach": 1}.get(hit.body_part)
+    rp, hp = np.asarray(hit.robot_point), np.asarray(hit.human_point)
     u = _side_axis(view)
     axis_name = "xy"[u]
     h = view.layout.reach.spacing
@@ -224,19 +224,19 @@ def contact_figure(view: EpisodeView, size: D.FigureSize = StillOptions().contac
     ax_side.set_axisbelow(True)
     other = "yx"[u]
     word = "contact" if view.unsafe else "closest call"
-    ax_top.set_title(f"top view at the {word}, t = {hit['t']:.2f} s", fontsize=10, loc="left")
+    ax_top.set_title(f"top view at the {word}, t = {hit.t:.2f} s", fontsize=10, loc="left")
     ax_side.set_title(f"side view ({axis_name}-z plane, looking along {other})", fontsize=10, loc="left")
-    handles = [Patch(facecolor=D.ROBOT_HIT, label=f"robot link {hit['robot_link']}"),
+    handles = [Patch(facecolor=D.ROBOT_HIT, label=f"robot link {hit.robot_link}"),
                Patch(facecolor=D.ROBOT, label="other robot links"),
                Patch(facecolor=D.BODY, alpha=0.75, label="worker's body capsules"),
                Patch(facecolor=D.REACH, alpha=0.3, edgecolor=D.REACH, label="reach volume (touching arm)"),
                Line2D([], [], color=D.REACH, ls="--", label="other arm's reach / shoulder to contact"),
                Line2D([], [], color=D.FENCE, lw=3.0, alpha=0.6, label="fence (side view: edge-on)"),
                Line2D([], [], color="black", lw=2, marker="o", ms=4,
-                      label=f"closest points, d_HR = {hit['d_HR']:.3f} m")]
+                      label=f"closest points, d_HR = {hit.d_HR:.3f} m")]
     fig.legend(handles=handles, loc="lower center", ncol=4, fontsize=8, frameon=False)
-    fig.suptitle(f"{spec.name}: {hit['robot_link']} / {hit['body_part']} at t = {hit['t']:.2f} s, "
-                 f"v_R = {hit['v_R']:.2f} m/s, {hit['stop_phase']}", fontsize=11, x=0.06, ha="left", y=0.98)
+    fig.suptitle(f"{spec.name}: {hit.robot_link} / {hit.body_part} at t = {hit.t:.2f} s, "
+                 f"v_R = {hit.v_R:.2f} m/s, {hit.stop_phase}", fontsize=11, x=0.06, ha="left", y=0.98)
     return fig
 
 

@@ -55,13 +55,13 @@ def _load(result: SearchResult | str | Path) -> tuple[SearchResult, Path | None]
 
 def _simulator(res: SearchResult, sim):
     from cellstress.cell.load import load_cell, with_criterion
+    from cellstress.cell.schema import DEFAULT_CRITERION
     from cellstress.sim.simulator import Simulator
 
-    if sim is not None and sim.cell.sha256 == res.cell.get("sha256"):
+    if sim is not None and sim.cell.sha256 == res.cell.sha256:
         return sim
     try:
-        return Simulator(with_criterion(load_cell(res.cell.get("source", res.cell["name"])),
-                                        res.cell.get("criterion", "contact-while-moving")))
+        return Simulator(with_criterion(load_cell(res.cell.source), res.cell.criterion or DEFAULT_CRITERION))
     except CellstressError as exc:
         raise ReportError(f"cannot load the result's cell: {exc}") from None
 
@@ -85,9 +85,9 @@ def write_report(result: SearchResult | str | Path, out_dir: str | Path | None =
     gif = animate(view, out / NAMES[2], options.animation, zone=zone)
     h = res.hazard
     title = f"{res.searcher}, seed {res.seed}: max risk per episode ({res.episodes} episodes)"
-    risk = D.save_png(risk_figure(res.risk_per_episode, h["episode"] if h else None, st.risk, title), out / NAMES[3])
+    risk = D.save_png(risk_figure(res.risk_per_episode, h.episode if h else None, st.risk, title), out / NAMES[3])
     acc = account(view, res.episodes)
-    changed = sim.cell.sha256 != res.cell.get("sha256")
+    changed = sim.cell.sha256 != res.cell.sha256
     page = hazard_page(res, view, acc, top, contact, gif, risk, changed)
     html = H.write_page(out / NAMES[4], page)
     return ReportFiles(top, contact, gif, risk, html, acc, res.found, changed)
@@ -104,25 +104,25 @@ def action_rows(view: EpisodeView) -> tuple[list[list], list[str]]:
         span = view.action_rows(k)
         rr = [recs[i] for i in span]
         last = rr[-1]
-        seen = sorted({d for r in rr for d in r["devices"]})
-        rows.append([k + 1, act, f"{recs[span.start - 1]['t']:.2f}-{last['t']:.2f}",
-                     f"({last['x']:.2f}, {last['y']:.2f})", f"{last['heading_deg']:.1f}",
-                     f"{last['forward_flexion_deg']:.1f}", f"{last['lateral_flexion_deg']:.1f}",
-                     _fmt(min(r["d_HR"] for r in rr)), _fmt(max(r["v_R"] for r in rr), 2),
-                     ", ".join(seen) or "-", last["stop_phase"]])
-        classes.append("unsafe" if any(r["unsafe"] for r in rr) else "")
+        seen = sorted({d for r in rr for d in r.devices})
+        rows.append([k + 1, act, f"{recs[span.start - 1].t:.2f}-{last.t:.2f}",
+                     f"({last.x:.2f}, {last.y:.2f})", f"{last.heading_deg:.1f}",
+                     f"{last.forward_flexion_deg:.1f}", f"{last.lateral_flexion_deg:.1f}",
+                     _fmt(min(r.d_HR for r in rr)), _fmt(max(r.v_R for r in rr), 2),
+                     ", ".join(seen) or "-", last.stop_phase])
+        classes.append("unsafe" if any(r.unsafe for r in rr) else "")
     return rows, classes
 
 
 def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, contact: Path, gif: Path,
                 risk: Path, cell_changed: bool) -> str:
-    cell = res.cell["name"]
+    cell = res.cell.name
     body = [f"<h1>cellstress report: {H.escape(cell)}</h1>"]
     if res.found:
         h = res.hazard
-        verdict = (f"<b>Hazard found</b> at episode {h['episode']} of {res.budget} ({res.searcher}, seed {res.seed}): "
-                   f"{H.escape(str(h['robot_link']))} / {H.escape(str(h['body_part']))} at t = {h['time_s']:.2f} s, "
-                   f"v_R = {h['v_R']:.2f} m/s.")
+        verdict = (f"<b>Hazard found</b> at episode {h.episode} of {res.budget} ({res.searcher}, seed {res.seed}): "
+                   f"{H.escape(str(h.robot_link))} / {H.escape(str(h.body_part))} at t = {h.time_s:.2f} s, "
+                   f"v_R = {h.v_R:.2f} m/s.")
         body.append(f'<div class="verdict hazard">{verdict}</div>')
     else:
         body.append(f'<div class="verdict safe"><b>No hazard found</b> in {res.episodes} episodes '
@@ -155,8 +155,8 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
     params = ", ".join(f"{k} = {v}" for k, v in sorted(res.params.items()))
     spec = view.layout.cell.spec
     body.append(H.table(None, [
-        ["cell", f"{cell} ({res.cell.get('source', '')})"],
-        ["cell sha256", str(res.cell.get("sha256", ""))],
+        ["cell", f"{cell} ({res.cell.source})"],
+        ["cell sha256", res.cell.sha256],
         ["searcher", f"{res.searcher} ({params})"],
         ["seed", res.seed], ["budget", f"{res.budget} episodes (until {res.until})"],
         ["episodes used", res.episodes], ["hazardous episodes", len(res.hazards)],
@@ -170,14 +170,14 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
         ["cellstress", res.version],
     ]))
     body.append("<h2>Trace</h2>")
-    trace_rows = [[r["step"], f"{r['t']:.2f}", r["action"] or "-", f"{r['x']:.3f}", f"{r['y']:.3f}",
-                   f"{r['heading_deg']:.1f}", f"{r['forward_flexion_deg']:.1f}", f"{r['lateral_flexion_deg']:.1f}",
-                   _fmt(r["d_HR"]), _fmt(r["v_R"]), r["stop_phase"], ", ".join(r["devices"]) or "-",
-                   f"{r['robot_link']} / {r['body_part']}"] for r in view.records]
+    trace_rows = [[r.step, f"{r.t:.2f}", r.action or "-", f"{r.x:.3f}", f"{r.y:.3f}",
+                   f"{r.heading_deg:.1f}", f"{r.forward_flexion_deg:.1f}", f"{r.lateral_flexion_deg:.1f}",
+                   _fmt(r.d_HR), _fmt(r.v_R), r.stop_phase, ", ".join(r.devices) or "-",
+                   f"{r.robot_link} / {r.body_part}"] for r in view.records]
     body.append("<details><summary>every simulation step</summary>")
     body.append(H.table(["step", "t [s]", "action", "x [m]", "y [m]", "heading", "forward", "lateral", "d_HR [m]",
                          "v_R [m/s]", "robot", "devices", "closest"], trace_rows, numeric={0, 1, 3, 4, 5, 6, 7, 8, 9},
-                        row_classes=["unsafe" if r["unsafe"] else "" for r in view.records]))
+                        row_classes=["unsafe" if r.unsafe else "" for r in view.records]))
     body.append("</details>")
     return H.page(f"cellstress report: {cell}", body, f"Made by cellstress {res.version} from {FILE_NAME} "
                   f"(searcher {res.searcher}, seed {res.seed}). Replay: cellstress replay {FILE_NAME}")

@@ -46,7 +46,7 @@ def action_words(action: str) -> str:
 
 
 def _xy(r: dict) -> str:
-    return f"({r['x']:.2f}, {r['y']:.2f}) m"
+    return f"({r.x:.2f}, {r.y:.2f}) m"
 
 
 def _device_kind(view: EpisodeView, name: str) -> tuple[str, float]:
@@ -70,8 +70,8 @@ def stop_request(view: EpisodeView, upto: int) -> tuple[float, str] | None:
     that sees the worker asks for a stop one response time later, and the earliest request wins."""
     best: tuple[float, str] | None = None
     for r in view.records[: upto + 1]:
-        for name in r["devices"]:
-            t_s = r["t"] + _device_kind(view, name)[1]
+        for name in r.devices:
+            t_s = r.t + _device_kind(view, name)[1]
             if best is None or t_s < best[0]:
                 best = (round(t_s, 9), name)
     return best
@@ -88,36 +88,36 @@ def account(view: EpisodeView, episodes: int | None = None) -> Account:
     for k, act in enumerate(view.actions):
         rows = view.action_rows(k)
         first, last = recs[rows.start - 1], recs[rows[-1]]
-        moved = math.hypot(last["x"] - first["x"], last["y"] - first["y"])
+        moved = math.hypot(last.x - first.x, last.y - first.y)
         walk = act.partition("+")[0]
         where = f"to {_xy(last)}" if moved > 0.005 else "in place"
         blocked = " (blocked: does not move)" if walk == "walk" and moved <= 0.005 else ""
-        details.append(f"Action {k + 1} ({first['t']:.2f}-{last['t']:.2f} s): {action_words(act)}, {where}"
-                       f"{blocked}; heading {last['heading_deg']:.0f}°, bent {last['forward_flexion_deg']:.0f}° "
-                       f"forward and {abs(last['lateral_flexion_deg']):.0f}° to the "
-                       f"{'left' if last['lateral_flexion_deg'] >= 0 else 'right'}.")
+        details.append(f"Action {k + 1} ({first.t:.2f}-{last.t:.2f} s): {action_words(act)}, {where}"
+                       f"{blocked}; heading {last.heading_deg:.0f}°, bent {last.forward_flexion_deg:.0f}° "
+                       f"forward and {abs(last.lateral_flexion_deg):.0f}° to the "
+                       f"{'left' if last.lateral_flexion_deg >= 0 else 'right'}.")
 
     det = view.detection_row
     seen_by = ""
     if det is not None and det <= key:
         r = recs[det]
         parts = []
-        for name in r["devices"]:
+        for name in r.devices:
             kind, resp = _device_kind(view, name)
             verb = kind
             parts.append(f"{verb} '{name}' (response {resp:g} s)")
         stop = stop_request(view, key)
-        details.append(f"At t = {r['t']:.2f} s the worker {' and '.join(parts)} at {_xy(r)}; the stop takes "
+        details.append(f"At t = {r.t:.2f} s the worker {' and '.join(parts)} at {_xy(r)}; the stop takes "
                        f"effect at t = {stop[0]:.2f} s." if stop else "")
-        seen_by = (f"is detected by '{', '.join(r['devices'])}' at t = {r['t']:.2f} s at {_xy(r)}; "
-                   f"{hit['t'] - r['t']:.2f} s after detection ")
+        seen_by = (f"is detected by '{', '.join(r.devices)}' at t = {r.t:.2f} s at {_xy(r)}; "
+                   f"{hit.t - r.t:.2f} s after detection ")
     else:
         details.append("No safety device detects the worker" + (" before the contact." if view.unsafe else "."))
-        seen_by = f"is never detected; at t = {hit['t']:.2f} s "
+        seen_by = f"is never detected; at t = {hit.t:.2f} s "
 
-    link, part = link_words(hit["robot_link"]), hit["body_part"]
-    px, py, pz = hit["robot_point"]
-    phase = hit["stop_phase"]
+    link, part = link_words(hit.robot_link), hit.body_part
+    px, py, pz = hit.robot_point
+    phase = hit.stop_phase
     stop = stop_request(view, key)
     if phase == "stop-pending" and stop:
         phase_text = f"a stop requested by '{stop[1]}' takes effect only at t = {stop[0]:.2f} s"
@@ -129,20 +129,20 @@ def account(view: EpisodeView, episodes: int | None = None) -> Account:
     moves = ", ".join(f"{_SHORT_TURNS.get(w, w)} {_SHORT_BODIES.get(b, b)}"
                       for w, _, b in (a.partition("+") for a in view.actions))
     if view.unsafe:
-        details.append(f"At t = {hit['t']:.2f} s (step {hit['step']}) the robot's {link} is "
+        details.append(f"At t = {hit.t:.2f} s (step {hit.step}) the robot's {link} is "
                        f"{_PARTS.get(part, part)} at ({px:.2f}, {py:.2f}, {pz:.2f}) m, while the robot moves at "
-                       f"v_R = {hit['v_R']:.2f} m/s: {phase_text}. "
+                       f"v_R = {hit.v_R:.2f} m/s: {phase_text}. "
                        + ("No stop was requested" if phase == "running" else "The stop is not complete")
                        + ": this is an unsafe contact.")
         headline = (f"The worker {moves}; it {seen_by}the robot's {link.split(' (')[0]} is "
-                    f"{_PARTS.get(part, part).replace('touches', 'touching')}, moving at {hit['v_R']:.2f} m/s; "
+                    f"{_PARTS.get(part, part).replace('touches', 'touching')}, moving at {hit.v_R:.2f} m/s; "
                     f"{'the stop is not complete' if phase != 'running' else 'no stop was requested'}.")
     else:
         n = f" in {episodes} episodes" if episodes is not None else ""
-        details.append(f"The closest call is at t = {hit['t']:.2f} s (step {hit['step']}): d_HR = "
-                       f"{hit['d_HR']:.3f} m between the robot's {link} and the worker's {part}, the robot moving at "
-                       f"v_R = {hit['v_R']:.2f} m/s; {phase_text}.")
+        details.append(f"The closest call is at t = {hit.t:.2f} s (step {hit.step}): d_HR = "
+                       f"{hit.d_HR:.3f} m between the robot's {link} and the worker's {part}, the robot moving at "
+                       f"v_R = {hit.v_R:.2f} m/s; {phase_text}.")
         headline = (f"No hazard was found{n}. The riskiest episode kept (episode {view.episode}) comes within "
-                    f"{hit['d_HR']:.3f} m of the robot's {link.split(' (')[0]} at t = {hit['t']:.2f} s, the robot "
-                    f"moving at {hit['v_R']:.2f} m/s.")
+                    f"{hit.d_HR:.3f} m of the robot's {link.split(' (')[0]} at t = {hit.t:.2f} s, the robot "
+                    f"moving at {hit.v_R:.2f} m/s.")
     return Account(headline, tuple(d for d in details if d))

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import asdict, fields
 from pathlib import Path
 
+from cellstress.cell.schema import DEFAULT_CRITERION
 from cellstress.core import registry
 from cellstress.core.errors import PluginError
 from cellstress.core.version import __version__
@@ -24,9 +25,17 @@ from cellstress.searchers.common import (
     Stop,
     check_common,
 )
-from cellstress.searchers.distinct import DistinctRecorder, DistinctReward, class_dict, distinct_problem
+from cellstress.searchers.distinct import DistinctRecorder, DistinctReward, distinct_problem, hazard_class_record
 from cellstress.searchers.multistart import MultiStartProblem
-from cellstress.searchers.result import SearchResult
+from cellstress.searchers.result import (
+    FORMAT,
+    CellRef,
+    DistinctHazard,
+    EpisodeRef,
+    Hazard,
+    SearchResult,
+    TopEpisode,
+)
 from cellstress.searchers.slices import ClassRecorder, cell_starts, run_slices
 from cellstress.sim.simulator import Simulator
 
@@ -142,37 +151,27 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
         def names(actions):
             return [ACTION_NAMES[a] for a in actions]
 
-    def hazard_record(actions):
+    def unsafe_trace(actions):
         trace = sim.run(names(actions))
-        return trace, trace.records()[trace.unsafe_row]
+        return trace, trace.records()
 
     hazard = None
     first = out.first_hazard
     if first is not None:
-        trace = sim.run(names(first.actions))
-        records = trace.records()
+        trace, records = unsafe_trace(first.actions)
         hit = records[trace.unsafe_row]
-        hazard = {
-            "episode": first.index,
-            "actions": names(first.actions),
-            "step": hit["step"],
-            "time_s": hit["t"],
-            "robot_link": hit["robot_link"],
-            "body_part": hit["body_part"],
-            "point": hit["robot_point"],
-            "human_point": hit["human_point"],
-            "v_R": hit["v_R"],
-            "d_HR": hit["d_HR"],
-            "trace": records,
-        }
-        verdict = sim.verdict(trace.rows[trace.unsafe_row])
-        if verdict is not None:  # a criterion that judges contacts: its account of this one
-            hazard[sim.criterion.type] = verdict.as_dict()
-    return SearchResult(
-        # a cell file by its absolute path, so that `cellstress replay` works from any folder
-        cell={"name": c.name, "sha256": c.sha256,
-              "source": c.source if c.directory is None else str(Path(c.source).expanduser().resolve()),
-              **_criterion_override(c)},
+        verdict = sim.verdict(trace.rows[trace.unsafe_row])  # a criterion that judges contacts: its account
+        hazard = Hazard.model_construct(
+            episode=first.index, actions=tuple(names(first.actions)), step=hit.step, time_s=hit.t,
+            robot_link=hit.robot_link, body_part=hit.body_part, point=hit.robot_point, human_point=hit.human_point,
+            v_R=hit.v_R, d_HR=hit.d_HR, trace=records,
+            **({} if verdict is None else {sim.criterion.type: verdict.as_dict()}))
+    # a cell file by its absolute path, so that `cellstress replay` works from any folder
+    source = c.source if c.directory is None else str(Path(c.source).expanduser().resolve())
+    crit = c.spec.criterion.type
+    return SearchResult.model_construct(
+        cell=CellRef.model_construct(name=c.name, sha256=c.sha256, source=source,
+                                     criterion=None if crit == DEFAULT_CRITERION else crit),
         searcher=s.name,
         params=asdict(s),
         seed=int(seed),
@@ -181,27 +180,23 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
         found=out.found,
         episodes=out.episodes,
         hazard=hazard,
-        hazards=[{"episode": h.index, "actions": names(h.actions)} for h in out.hazards],
-        top=[{"episode": e.index, "actions": names(e.actions), "return": e.ret, "risk": e.risk,
-              "unsafe": e.unsafe} for e in out.top],
-        risk_per_episode=list(out.risks),
+        hazards=tuple(EpisodeRef.model_construct(episode=h.index, actions=tuple(names(h.actions)))
+                      for h in out.hazards),
+        top=tuple(TopEpisode.model_construct(episode=e.index, actions=tuple(names(e.actions)), ret=e.ret,
+                                             risk=e.risk, unsafe=e.unsafe) for e in out.top),
+        risk_per_episode=tuple(out.risks),
         version=__version__,
-        distinct=None if rec is None else _distinct_list(rec.classes, names, hazard_record),
+        format=FORMAT,
+        distinct=None if rec is None else _distinct_list(rec.classes, names, unsafe_trace),
     )
 
 
-def _distinct_list(classes, names, hazard_record) -> list[dict]:
+def _distinct_list(classes, names, unsafe_trace) -> tuple[DistinctHazard, ...]:
     out = []
     for key, (episode, actions) in classes.items():
-        trace, hit = hazard_record(actions)
-        out.append({"class": class_dict(key), "episode": episode, "actions": names(actions), "step": hit["step"],
-                    "time_s": hit["t"], "robot_link": hit["robot_link"], "body_part": hit["body_part"],
-                    "v_R": hit["v_R"], "trace": trace.records()})
-    return out
-
-
-def _criterion_override(cell) -> dict:
-    """{"criterion": name} unless the cell is judged by the paper's criterion (the default, which keeps older
-    result files as they were); replay and report apply it with ``cell.load.with_criterion``."""
-    t = cell.spec.criterion.type
-    return {} if t == "contact-while-moving" else {"criterion": t}
+        trace, records = unsafe_trace(actions)
+        hit = records[trace.unsafe_row]
+        out.append(DistinctHazard.model_construct(
+            klass=hazard_class_record(key), episode=episode, actions=tuple(names(actions)), step=hit.step,
+            time_s=hit.t, robot_link=hit.robot_link, body_part=hit.body_part, v_R=hit.v_R, trace=records))
+    return tuple(out)

@@ -24,6 +24,7 @@ from cellstress.core.protocols import StartChoices
 from cellstress.core.records import Measures
 from cellstress.human.regions import body_region
 from cellstress.searchers.common import Recorder, Stop
+from cellstress.searchers.result import HazardClass
 from cellstress.sim.layout import M_FWD, M_HEADING, M_HX, M_HZ, M_LAT, M_LINK, M_PART, M_X, M_Y, S_TRIG_DEV
 from cellstress.sim.scene import body_pose
 
@@ -42,10 +43,12 @@ def hazard_class(sim, state, row) -> tuple:
     return (device, link, region, math.floor(row[M_X] / CELL_SIZE), math.floor(row[M_Y] / CELL_SIZE))
 
 
-def class_dict(key: tuple) -> dict:
+def hazard_class_record(key: tuple) -> HazardClass:
+    """The class key of ``hazard_class`` as the result file's record."""
     device, link, region, cx, cy = key
-    return {"device": device, "robot_link": link, "body_region": region,
-            "approach_cell": [cx * CELL_SIZE, cy * CELL_SIZE, (cx + 1) * CELL_SIZE, (cy + 1) * CELL_SIZE]}
+    return HazardClass.model_construct(device=device, robot_link=link, body_region=region,
+                                       approach_cell=(cx * CELL_SIZE, cy * CELL_SIZE, (cx + 1) * CELL_SIZE,
+                                                      (cy + 1) * CELL_SIZE))
 
 
 class DistinctProblem:

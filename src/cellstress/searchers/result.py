@@ -1,4 +1,9 @@
-"""The result record of a search and its JSON file.
+"""The result record of a search and its JSON file (``result.json``).
+
+Typed, frozen records: the same types are made by a search (without validation: the values are ours) and
+checked when a result file is read (``SearchResult.load``): result files come from other people, so a file is
+parsed with strict types (no ``true`` for a number, no text for a number), bounded sizes and nesting, and any
+problem is one ``SearchError`` naming the file, the field and the problem.
 
 ``result.json`` holds no wall-clock fields: the same inputs give a byte-identical file (keys sorted, floats
 written with Python's shortest round-trip repr, non-finite floats as null, written atomically through a
@@ -7,44 +12,141 @@ temporary file and ``os.replace``). Timing goes to the console only.
 
 from __future__ import annotations
 
-import json
-from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, Literal
 
-from cellstress.core.io import atomic_write, canonical_json, json_ready
-from cellstress.searchers.common import SearchError
+from pydantic import ConfigDict, Field, TypeAdapter, ValidationError, model_validator
+
+from cellstress.core import registry
+from cellstress.core.fields import Record
+from cellstress.core.io import InputFileError, atomic_write, canonical_json, json_ready, read_input_bytes
+from cellstress.searchers.common import UNTIL, SearchError
+from cellstress.sim.records import Name, StepRecord
 
 FORMAT = 1
 FILE_NAME = "result.json"
+MAX_EPISODES = 10_000_000  # the budget a result may claim (the command line allows no more)
+MAX_ACTIONS = 101  # a start point and up to 100 actions (SimulationSpec.actions_per_episode <= 100)
+MAX_ROWS = 1 + 100 * 100  # the rows of one episode: 100 actions of up to 100 steps
+MAX_LISTED = 100_000  # hazards, classes and kept episodes listed in one file
+
+Episode = Annotated[int, Field(ge=1, le=MAX_EPISODES)]
+Actions = Annotated[tuple[Name, ...], Field(max_length=MAX_ACTIONS)]
+Trace = Annotated[tuple[StepRecord, ...], Field(max_length=MAX_ROWS)]
+Option = bool | int | float | Annotated[str, Field(max_length=1000)] | None
+VERDICT = TypeAdapter(dict[Name, bool | int | float | Annotated[str, Field(max_length=1000)] | None
+                           | Annotated[list[float], Field(max_length=16)]])
 
 
-@dataclass(frozen=True)
-class SearchResult:
+class CellRef(Record):
+    """The cell searched: its name, the sha256 of its file's text, where it came from (a built-in name or an
+    absolute path), and the criterion it was judged by when that is not its own."""
+
+    name: Name
+    sha256: Annotated[str, Field(pattern=r"^[0-9a-f]{64}$")]
+    source: Annotated[str, Field(max_length=4096)]
+    criterion: Name | None = None
+
+
+class HazardClass(Record):
+    """A distinct-mode class (``searchers.distinct``): the device that stopped the robot too late (or ``none``),
+    the robot link, the ISO/TS 15066 body region, the 0.5 m floor cell (x0, y0, x1, y1) of the approach."""
+
+    device: Name
+    robot_link: Name
+    body_region: Name
+    approach_cell: tuple[float, float, float, float]
+
+
+class EpisodeRef(Record):
+    episode: Episode
+    actions: Actions
+
+
+class TopEpisode(Record):
+    episode: Episode
+    actions: Actions
+    ret: float | None = Field(alias="return")
+    risk: float | None
+    unsafe: bool
+
+
+class Hazard(Record):
+    """The first hazardous episode: its actions, the unsafe step and its trace. A criterion that judges contacts
+    adds its verdict under the criterion's name (e.g. ``iso15066``): the one field not declared here."""
+
+    model_config = ConfigDict(extra="allow")
+
+    episode: Episode
+    actions: Actions
+    step: Annotated[int, Field(ge=0, le=MAX_ROWS)]
+    time_s: float
+    robot_link: Name | None
+    body_part: Name | None
+    point: tuple[float, float, float]
+    human_point: tuple[float, float, float]
+    v_R: float | None
+    d_HR: float | None
+    trace: Trace
+
+    @model_validator(mode="after")
+    def _one_verdict(self) -> Hazard:
+        extra = self.model_extra or {}
+        for key, value in extra.items():
+            if key not in registry.names("criteria"):
+                raise ValueError(f"unknown field {key!r}")
+            VERDICT.validate_python(value, strict=True)
+        if len(extra) > 1:
+            raise ValueError(f"more than one criterion's verdict ({', '.join(sorted(extra))})")
+        return self
+
+    @property
+    def verdict(self) -> tuple[str, dict[str, Any]] | None:
+        """(criterion, its verdict's numbers) for a criterion that judges contacts, else None."""
+        extra = self.model_extra or {}
+        return next(iter(extra.items()), None)
+
+
+class DistinctHazard(Record):
+    """The first hazard of one class (distinct mode)."""
+
+    klass: HazardClass = Field(alias="class")
+    episode: Episode
+    actions: Actions
+    step: Annotated[int, Field(ge=0, le=MAX_ROWS)]
+    time_s: float
+    robot_link: Name | None
+    body_part: Name | None
+    v_R: float | None
+    trace: Trace
+
+
+class SearchResult(Record):
     """What ``cellstress.search`` returns and ``result.json`` holds."""
 
-    cell: dict[str, Any]  # name, sha256, source
-    searcher: str
-    params: dict[str, Any]  # the searcher's options (defaults filled in)
-    seed: int
-    budget: int
-    until: str
+    cell: CellRef
+    searcher: Name
+    params: dict[Name, Option]  # the searcher's options (defaults filled in)
+    seed: Annotated[int, Field(ge=0)]
+    budget: Episode
+    until: Literal[UNTIL]
     found: bool
-    episodes: int  # used, up to and including the first hazard (until=first) or the whole budget
-    hazard: dict[str, Any] | None  # the first hazardous episode, with its trace
-    hazards: list[dict[str, Any]]  # every hazardous episode: {episode, actions}
-    top: list[dict[str, Any]]  # the top-k episodes by return: {episode, actions, return, risk, unsafe}
-    risk_per_episode: list[float]  # max 1/c_S of each episode
-    version: str
-    format: int = FORMAT
-    # distinct mode only (absent from the file otherwise): the first hazard of each class, in the order found:
-    # {class, episode, actions, step, time_s, robot_link, body_part, v_R, trace}
-    distinct: list[dict[str, Any]] | None = None
+    episodes: Annotated[int, Field(ge=0, le=MAX_EPISODES)]  # used: up to the first hazard, or the whole budget
+    hazard: Hazard | None  # the first hazardous episode, with its trace
+    hazards: Annotated[tuple[EpisodeRef, ...], Field(max_length=MAX_LISTED)]  # every hazardous episode
+    top: Annotated[tuple[TopEpisode, ...], Field(max_length=MAX_LISTED)]  # the top-k episodes by return
+    risk_per_episode: Annotated[tuple[float | None, ...], Field(max_length=MAX_EPISODES)]  # max 1/c_S each
+    version: Name
+    format: Literal[1] = FORMAT
+    # distinct mode only (absent from the file otherwise): the first hazard of each class, in the order found
+    distinct: Annotated[tuple[DistinctHazard, ...], Field(max_length=MAX_LISTED)] | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        doc = asdict(self)
+        doc = self.model_dump(by_alias=True)
         if doc["distinct"] is None:
             del doc["distinct"]
+        if doc["cell"]["criterion"] is None:
+            del doc["cell"]["criterion"]
         return json_ready(doc)
 
     def to_json(self) -> str:
@@ -59,24 +161,32 @@ class SearchResult:
         return path
 
     @classmethod
-    def from_dict(cls, doc: dict[str, Any]) -> SearchResult:
-        return cls(**doc)
-
-    @classmethod
     def load(cls, path: str | Path) -> SearchResult:
+        """Read and check a result file (or the ``result.json`` in a folder); SearchError with one line naming
+        the file, the field and the problem for anything that is not a result file of ours."""
         p = Path(path)
         if p.is_dir():
             p = p / FILE_NAME
         try:
-            doc = json.loads(p.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise SearchError(f"{p}: no such result file") from None
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise SearchError(f"{p}: not a readable result file ({exc})") from None
-        fields = set(cls.__dataclass_fields__)
-        if not isinstance(doc, dict) or not {"cell", "hazard", "searcher"} <= set(doc) or set(doc) - fields:
-            raise SearchError(f"{p}: not a cellstress result file")
+            raw = read_input_bytes(p)
+        except InputFileError as exc:
+            problem = "no such result file" if exc.problem == "no such file" else exc.problem
+            raise SearchError(f"{p}: {problem}") from None
         try:
-            return cls.from_dict(doc)
-        except TypeError as exc:
-            raise SearchError(f"{p}: not a cellstress result file ({exc})") from None
+            return cls.model_validate_json(raw, strict=True)
+        except ValidationError as exc:
+            raise SearchError(f"{p}: not a cellstress result file: {_problem(exc)}") from None
+
+
+def _problem(exc: ValidationError) -> str:
+    """The first problem of a validation error in one line: the field's path and what is wrong (the value is
+    never echoed whole: it may be huge or hostile)."""
+    errors = exc.errors(include_input=False, include_url=False)
+    e = errors[0]
+    where = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in e["loc"]).lstrip(".") or "(top level)"
+    msg = e["msg"]
+    if e["type"] == "json_invalid":
+        msg = f"invalid JSON ({e.get('ctx', {}).get('error', 'malformed')})"
+        where = "(file)"
+    more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
+    return f"{where}: {msg[:200]}{more}"

@@ -25,9 +25,8 @@ from cellstress.sim import kernels as K
 from cellstress.sim.build import Layout, build_layout, with_phase
 from cellstress.sim.contacts import ContactModel
 from cellstress.sim.lookahead import Lookahead
+from cellstress.sim.records import STOP_PHASES, StepRecord
 from cellstress.sim.starts import START_PREFIX, split_start
-
-STOP_PHASES = ("running", "stop-pending", "braking", "stopped")
 
 
 @dataclass(frozen=True)
@@ -47,38 +46,38 @@ class Trace:
         hits = np.flatnonzero(self.rows[:, K.M_UNSAFE])
         return int(hits[0]) if hits.size else None
 
-    def record(self, i: int) -> dict:
+    def record(self, i: int) -> StepRecord:
         return step_record(self.rows[i], self.layout)
 
-    def records(self) -> list[dict]:
-        return [step_record(r, self.layout) for r in self.rows]
+    def records(self) -> tuple[StepRecord, ...]:
+        return tuple(step_record(r, self.layout) for r in self.rows)
 
 
-def step_record(row: np.ndarray, layout: Layout) -> dict:
-    """One metric row as named, JSON-ready values."""
+def step_record(row: np.ndarray, layout: Layout) -> StepRecord:
+    """One metric row as a named record (made without validation: the row is the simulator's own)."""
     seen = int(row[K.M_SEEN])
     link = int(row[K.M_LINK])
     part = int(row[K.M_PART])
     act = int(row[K.M_ACTION])
-    return {
-        "step": int(row[K.M_STEP]),
-        "t": round(float(row[K.M_T]), 9),  # k * dt carries float noise (0.6000000000000001)
-        "action": ACTION_NAMES[act] if act >= 0 else None,
-        "x": float(row[K.M_X]),
-        "y": float(row[K.M_Y]),
-        "heading_deg": float(np.rad2deg(row[K.M_HEADING])),
-        "forward_flexion_deg": float(np.rad2deg(row[K.M_FWD])),
-        "lateral_flexion_deg": float(np.rad2deg(row[K.M_LAT])),
-        "d_HR": float(row[K.M_D]),
-        "v_R": float(row[K.M_V]),
-        "devices": [n for i, n in enumerate(layout.device_names) if seen >> i & 1],
-        "stop_phase": STOP_PHASES[int(row[K.M_PHASE])],
-        "robot_link": layout.capsules[link].name if link >= 0 else None,
-        "body_part": BODY_PARTS[part] if part >= 0 else None,
-        "robot_point": [float(v) for v in row[K.M_RX:K.M_RZ + 1]],
-        "human_point": [float(v) for v in row[K.M_HX:K.M_HZ + 1]],
-        "unsafe": bool(row[K.M_UNSAFE]),
-    }
+    return StepRecord.model_construct(
+        step=int(row[K.M_STEP]),
+        t=round(float(row[K.M_T]), 9),  # k * dt carries float noise (0.6000000000000001)
+        action=ACTION_NAMES[act] if act >= 0 else None,
+        x=float(row[K.M_X]),
+        y=float(row[K.M_Y]),
+        heading_deg=float(np.rad2deg(row[K.M_HEADING])),
+        forward_flexion_deg=float(np.rad2deg(row[K.M_FWD])),
+        lateral_flexion_deg=float(np.rad2deg(row[K.M_LAT])),
+        d_HR=float(row[K.M_D]),
+        v_R=float(row[K.M_V]),
+        devices=tuple(n for i, n in enumerate(layout.device_names) if seen >> i & 1),
+        stop_phase=STOP_PHASES[int(row[K.M_PHASE])],
+        robot_link=layout.capsules[link].name if link >= 0 else None,
+        body_part=BODY_PARTS[part] if part >= 0 else None,
+        robot_point=tuple(float(v) for v in row[K.M_RX:K.M_RZ + 1]),
+        human_point=tuple(float(v) for v in row[K.M_HX:K.M_HZ + 1]),
+        unsafe=bool(row[K.M_UNSAFE]),
+    )
 
 
 @dataclass(frozen=True, eq=False)
