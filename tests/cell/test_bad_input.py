@@ -135,7 +135,7 @@ CASES = [
         "zero-dt",
         lambda c: c.setdefault("simulation", {}).update(dt=0.0),
         "simulation.dt",
-        ("greater than 0",),
+        ("greater than or equal to 0.001",),
     ),
     Case(
         "table-polygon-2-points",

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import difflib
 import hashlib
+import math
+import re
+import reprlib
 import types
 import typing
 from dataclasses import dataclass, replace
@@ -13,9 +16,14 @@ from pathlib import Path
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from cellstress.cell.schema import CRITERIA, DEVICE_KINDS, CellSpec
+from cellstress.cell.schema import CRITERIA, DEVICE_KINDS, MAX_CYCLE, CellSpec
 from cellstress.core import registry
 from cellstress.core.errors import CellError, CellstressError
+from cellstress.core.io import MAX_INPUT_BYTES, InputFileError, read_input_bytes
+from cellstress.core.plane import point_segment_distance, polygon_distance
+from cellstress.human.body import BODY_RADIUS, WALK_BLOCK_HEIGHT
+from cellstress.robot.model import load_robot, resolve_urdf
+from cellstress.robot.trajectory import build_trajectory
 
 BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap", "all-flaws")
 
@@ -48,8 +56,13 @@ def builtin_text(name: str) -> str:
             from None
 
 
+MAX_VALUES = 200_000  # values in a cell file once its aliases are expanded (a big cell has about 2,000)
+MAX_DEPTH = 40  # nesting of lists and mappings (a cell needs 5)
+
+
 class _CellLoader(yaml.SafeLoader):
-    """PyYAML's safe loader (plain data only, no Python tags) that also rejects repeated keys."""
+    """PyYAML's safe loader (plain data only, no Python tags) that also rejects repeated keys and reads
+    numbers such as ``1e-3`` as YAML 1.2 does (YAML 1.1 would make them text)."""
 
     def construct_mapping(self, node, deep=False):
         seen: dict = {}
@@ -66,9 +79,32 @@ class _CellLoader(yaml.SafeLoader):
         return super().construct_mapping(node, deep=deep)
 
 
+_CellLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float", re.compile(r"^[-+]?[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"), list("-+0123456789"))
+
+
 def safe_load_yaml(text: str):
     """Parse YAML as plain data (never Python objects), rejecting duplicate keys."""
     return yaml.load(text, Loader=_CellLoader)  # noqa: S506 - _CellLoader is a SafeLoader
+
+
+class _TooBig(Exception):
+    pass
+
+
+def _frozen(data, budget: list[int], depth: int = 0):
+    """``data`` with every list made a tuple (the schema's containers), counting values against ``budget``:
+    YAML aliases can make a small file expand to billions of values, and deep nesting can exhaust the stack."""
+    budget[0] -= 1
+    if budget[0] < 0:
+        raise _TooBig(f"the file expands to more than {MAX_VALUES:,} values (YAML aliases?)")
+    if depth > MAX_DEPTH:
+        raise _TooBig(f"lists and mappings are nested more than {MAX_DEPTH} deep")
+    if isinstance(data, list):
+        return tuple(_frozen(v, budget, depth + 1) for v in data)
+    if isinstance(data, dict):
+        return {k: _frozen(v, budget, depth + 1) for k, v in data.items()}
+    return data
 
 
 # pydantic puts the tag of a tagged-union branch into an error's location; it is not a field name
@@ -143,10 +179,17 @@ def _unknown_field_message(loc: tuple) -> str:
     return f"unknown field; {hint}allowed here: {', '.join(allowed)}"
 
 
+def _short_repr() -> reprlib.Repr:
+    r = reprlib.Repr()  # (Python 3.11's Repr takes no keyword arguments)
+    r.maxlevel, r.maxtuple, r.maxlist, r.maxdict, r.maxstring, r.maxother = 2, 4, 4, 4, 30, 30
+    return r
+
+
 def _describe(value: object) -> str:
+    """A value as a short text: never the whole of it (it may be huge, or an alias bomb)."""
     if value is None:
         return "nothing (null)"
-    text = repr(value)
+    text = _short_repr().repr(value)
     return text if len(text) <= 40 else text[:37] + "..."
 
 
@@ -216,8 +259,12 @@ def _follow_on(err: dict) -> bool:
 
 
 def parse_cell(text: str, source: str, directory: Path | None) -> Cell:
+    if len(text) > MAX_INPUT_BYTES:
+        raise CellError(source, "", f"is too large ({len(text):,} characters; at most {MAX_INPUT_BYTES:,})")
     try:
         data = safe_load_yaml(text)
+    except RecursionError:
+        raise CellError(source, "YAML", f"lists and mappings are nested more than {MAX_DEPTH} deep") from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "YAML"
@@ -235,7 +282,11 @@ def parse_cell(text: str, source: str, directory: Path | None) -> Cell:
         raise CellError(source, "(top level)",
                         f"a cell file holds a mapping of fields (name: ..., robot: ...), not a {what}")
     try:
-        spec = CellSpec.model_validate(data)
+        data = _frozen(data, [MAX_VALUES])
+    except _TooBig as exc:
+        raise CellError(source, "(top level)", str(exc)) from None
+    try:
+        spec = CellSpec.model_validate(data, strict=True)
     except ValidationError as exc:
         errors = _merge_short_tuples([e for e in exc.errors() if not _follow_on(e)] or exc.errors())
         field, msg = _validation_problem(errors[0])
@@ -252,15 +303,14 @@ def load_cell(name_or_path: str | Path) -> Cell:
     if ref in BUILTIN_CELLS:
         return parse_cell(builtin_text(ref), ref, None)
     path = Path(ref).expanduser()
-    if not path.exists():
-        known = ", ".join(BUILTIN_CELLS)
-        raise CellError(ref, "", f"no such file, and not a built-in cell ({known})")
-    if path.is_dir():
-        raise CellError(ref, "", "is a directory, not a cell file")
     try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise CellError(ref, "", f"cannot be read: {exc.strerror}") from None
+        raw = read_input_bytes(path)
+    except InputFileError as exc:
+        if exc.problem == "no such file":
+            raise CellError(ref, "", f"no such file, and not a built-in cell ({', '.join(BUILTIN_CELLS)})") from None
+        if exc.problem.startswith("is a directory"):
+            raise CellError(ref, "", "is a directory, not a cell file") from None
+        raise CellError(ref, "", exc.problem) from None
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -272,10 +322,8 @@ def load_cell(name_or_path: str | Path) -> Cell:
 
 
 def check_geometry(cell: Cell) -> None:
-    """Checks that need more than one field: the URDF, the waypoints against it, the start pose."""
-    from cellstress.robot.model import load_robot, resolve_urdf
-    from cellstress.sim.geometry import point_segment_2d, polygon_distance
-
+    """Checks that need more than one field: the URDF, the waypoints against its joints and their limits, the
+    robot's cycle time, the start pose and every named start point."""
     spec, src = cell.spec, cell.source
     urdf = resolve_urdf(spec.robot.urdf, cell.directory)
     if not urdf.is_file():
@@ -287,10 +335,21 @@ def check_geometry(cell: Cell) -> None:
     except Exception as exc:  # pinocchio raises plain RuntimeError/ValueError for unreadable URDFs
         raise CellError(src, "robot.urdf", f"pinocchio cannot read it: {str(exc).splitlines()[0]}") from None
     nj = robot.n_joints
-    for i, w in enumerate(spec.robot.task.waypoints_deg):
+    task = spec.robot.task
+    for i, w in enumerate(task.waypoints_deg):
         if len(w) != nj:
             raise CellError(src, f"robot.task.waypoints_deg[{i}]",
                             f"has {len(w)} joint values but the robot has {nj} joints")
+        for j, deg in enumerate(w):
+            lo, hi = math.degrees(robot.lower[j]), math.degrees(robot.upper[j])
+            if not lo - 1e-6 <= deg <= hi + 1e-6:
+                raise CellError(src, f"robot.task.waypoints_deg[{i}][{j}]",
+                                f"{deg:g} deg is outside joint {robot.joint_names[j]!r}'s limits "
+                                f"{lo:.1f}..{hi:.1f} deg")
+    cycle = build_trajectory(task.waypoints_deg, task.dwell, task.speed_scale, robot.velocity_limits).cycle
+    if cycle > MAX_CYCLE:
+        raise CellError(src, "robot.task", f"the cycle takes {cycle:.0f} s; at most {MAX_CYCLE:.0f} s "
+                                           "(raise speed_scale, shorten dwell)")
     caps = spec.robot.capsules if spec.robot.capsules != "auto" else ()
     for i, c in enumerate(tuple(caps) + spec.robot.extra_capsules):
         if c.link not in robot.link_joint:
@@ -298,22 +357,25 @@ def check_geometry(cell: Cell) -> None:
                      else f"robot.extra_capsules[{i - len(caps)}].link")
             raise CellError(src, field, f"the robot has no link {c.link!r}; its links are "
                                         f"{', '.join(sorted(robot.link_joint))}")
-    import numpy as np
+    _check_standing_point(cell, "human.start.xy", spec.human.start.xy)
+    for i, s in enumerate(spec.human.starts):
+        _check_standing_point(cell, f"human.starts[{i}].xy", s.xy)
 
-    x, y = spec.human.start.xy
-    r = 0.20
+
+def _check_standing_point(cell: Cell, where: str, xy) -> None:
+    """A start point must be on the floor (the body's footprint inside it), off the table and clear of fences."""
+    spec, src, r = cell.spec, cell.source, BODY_RADIUS
+    x, y = xy
     fl = spec.floor
-    where = "human.start.xy"
     if not (fl.xmin + r <= x <= fl.xmax - r and fl.ymin + r <= y <= fl.ymax - r):
         raise CellError(src, where, f"({x}, {y}) is not on the floor x {fl.xmin}..{fl.xmax}, "
                                     f"y {fl.ymin}..{fl.ymax} (keeping the body's {r} m radius inside)")
     for i, poly in enumerate(spec.table.polygons):
-        verts = np.asarray(poly, dtype=float)
-        if polygon_distance(x, y, verts, 0, len(verts)) < r:
+        if polygon_distance(x, y, poly) < r:
             raise CellError(src, where, f"({x}, {y}) is inside or touching the table (table.polygons[{i}])")
     for i, fence in enumerate(spec.fences):
         for a, b in zip(fence.points, fence.points[1:], strict=False):
-            if fence.bottom < 0.5 and point_segment_2d(x, y, a[0], a[1], b[0], b[1]) < r:
+            if fence.bottom < WALK_BLOCK_HEIGHT and point_segment_distance(x, y, a, b) < r:
                 raise CellError(src, where, f"({x}, {y}) is inside or touching a fence (fences[{i}])")
 
 

@@ -2,6 +2,10 @@
 
 Lengths are metres, angles degrees, times seconds. Cell records (``cell.schema``) and the records of device
 and criterion plug-ins are built from these, so every file field is checked the same way.
+
+Cell files come from other people, so every number has a physically sensible range (no allocation or loop
+may grow with a number a user wrote without a cap) and every list a length cap. Files are validated strictly
+(``cell.load``): ``true`` is not a number, ``"1.5"`` is not a number.
 """
 
 from __future__ import annotations
@@ -10,12 +14,25 @@ from typing import Annotated
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
+MAX_EXTENT = 100.0  # m: every coordinate of a cell lies within this of the origin (a cell, not a factory)
+MAX_HEIGHT = 10.0  # m: fences, tables, devices
+MAX_VERTICES = 256  # per polygon or fence polyline
+MAX_TIME = 10.0  # s: response and stopping times
+
 Finite = Annotated[float, Field(allow_inf_nan=False)]
-Point2 = tuple[Finite, Finite]
-Point3 = tuple[Finite, Finite, Finite]
-PositiveTime = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
-Length = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+Coordinate = Annotated[float, Field(ge=-MAX_EXTENT, le=MAX_EXTENT, allow_inf_nan=False)]
+Point2 = tuple[Coordinate, Coordinate]
+Point3 = tuple[Coordinate, Coordinate, Coordinate]
+Angle = Annotated[float, Field(ge=-360.0, le=360.0, allow_inf_nan=False)]
+PositiveTime = Annotated[float, Field(gt=0.0, le=MAX_TIME, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0.0, le=MAX_EXTENT, allow_inf_nan=False)]
+Length = Annotated[float, Field(gt=0.0, le=MAX_EXTENT, allow_inf_nan=False)]
+Height = Annotated[float, Field(gt=0.0, le=MAX_HEIGHT, allow_inf_nan=False)]
+Elevation = Annotated[float, Field(ge=0.0, le=MAX_HEIGHT, allow_inf_nan=False)]
+# a name shown in text, tables and pictures: printable, one line (no control characters, no bidirectional
+# overrides that would reorder what a terminal shows), not too long
+PRINTABLE = r"^[^\x00-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]+$"
+Name = Annotated[str, Field(min_length=1, max_length=100, pattern=PRINTABLE)]
 
 
 class Record(BaseModel):
@@ -54,4 +71,4 @@ def check_simple_polygon(points: tuple[Point2, ...]) -> tuple[Point2, ...]:
 
 
 # A simple polygon; validated per polygon so that errors name the polygon's index (table.polygons[1]).
-Polygon = Annotated[tuple[Point2, ...], AfterValidator(check_simple_polygon)]
+Polygon = Annotated[tuple[Point2, ...], Field(max_length=MAX_VERTICES), AfterValidator(check_simple_polygon)]

@@ -2,16 +2,12 @@
 
 from __future__ import annotations
 
-from typing import Annotated
-
-from pydantic import Field
-
-from cellstress.core.fields import PositiveTime, Record
+from cellstress.core.fields import Name, PositiveTime, Record
 
 
 class DeviceRecord(Record):
     """The fields every device kind shares. A device kind is a subclass with a ``type: Literal[...]`` tag (its
     name in cell files and in the ``cellstress.devices`` registry) and the ``core.protocols.Device`` methods."""
 
-    name: Annotated[str, Field(min_length=1)]
+    name: Name
     response_time: PositiveTime

@@ -12,7 +12,7 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field, model_validator
 
-from cellstress.core.fields import Length, NonNegative, Point2, PositiveTime
+from cellstress.core.fields import Elevation, Height, Point2, PositiveTime
 from cellstress.core.iso13855 import K_HAND, K_WALK, MIN_C_BODY, mm
 from cellstress.core.records import IsoDistance, VerticalField
 from cellstress.devices.base import DeviceRecord
@@ -45,8 +45,8 @@ class LightCurtain(DeviceRecord):
     type: Literal["light-curtain"]
     start: Point2
     end: Point2
-    bottom: NonNegative = 0.2
-    top: Length = 1.8
+    bottom: Elevation = 0.2
+    top: Height = 1.8
     response_time: PositiveTime = 0.05
     resolution_mm: Annotated[float, Field(gt=0.0, le=200.0)] = 30.0
 

@@ -24,6 +24,8 @@ BODY_PARTS: tuple[str, ...] = (
     "right-reach",
 )
 N_CAPSULES = 6  # the first six parts are capsules; the last two are the reach volumes
+BODY_RADIUS = 0.20  # m, the footprint that keeps the body centre from fences and table edges
+WALK_BLOCK_HEIGHT = 0.5  # m: a fence panel whose bottom is above this does not stop walking (the worker ducks)
 
 # Indices into the body parameter vector used by the kernel.
 B_HIP_Z, B_SHOULDER_RISE, B_SHOULDER_HALF, B_LEG_HALF, B_HEAD_RISE, B_TRUNK_TOP = range(6)
@@ -38,7 +40,7 @@ class BodyDimensions:
     forearm: float
     hand: float
     walking_speed: float
-    body_radius: float = 0.20  # footprint radius that keeps the body centre from fences and table edges
+    body_radius: float = BODY_RADIUS
 
     @property
     def arm_length(self) -> float:
