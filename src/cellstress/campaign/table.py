@@ -26,6 +26,8 @@ from typing import Any
 
 from cellstress.campaign.paper import PaperRow, paper_table
 from cellstress.campaign.plan import CampaignPlan
+from cellstress.core.io import atomic_write_text
+from cellstress.core.text import for_csv, for_markdown
 
 CONFIDENCE = 0.95
 BASELINE = "random"
@@ -159,7 +161,7 @@ def markdown(rows: list[Row], plan: CampaignPlan) -> str:
         ci = "" if r.mean_ci is None else f" ({r.mean_ci.lo:.1f}–{r.mean_ci.hi:.1f})"
         p = r.paper
         lines.append(
-            f"| {r.cell} | {r.searcher} | {r.found}/{r.runs} | {r.success_rate:.2f} "
+            f"| {for_markdown(r.cell)} | {for_markdown(r.searcher)} | {r.found}/{r.runs} | {r.success_rate:.2f} "
             f"({r.success_ci.lo:.2f}–{r.success_ci.hi:.2f}) | {r.mean_episodes:.1f}{ci} | "
             f"{r.median_episodes:.1f} | {_f(r.ratio_to_random, 2)} | "
             f"{'–' if p is None else f'{p.found}/{p.runs}'} | {_f(None if p is None else p.mean_episodes, 1)} | "
@@ -183,7 +185,7 @@ def csv_text(rows: list[Row]) -> str:
     w.writerow(CSV_COLUMNS)
     for r in rows:
         p = r.paper
-        w.writerow([r.cell, r.searcher, r.runs, r.found, _c(r.success_rate), _c(r.success_ci.lo),
+        w.writerow([for_csv(r.cell), for_csv(r.searcher), r.runs, r.found, _c(r.success_rate), _c(r.success_ci.lo),
                     _c(r.success_ci.hi), _c(r.mean_episodes), _c(r.mean_ci and r.mean_ci.lo),
                     _c(r.mean_ci and r.mean_ci.hi), _c(r.median_episodes), _c(r.ratio_to_random),
                     "" if p is None else p.runs, "" if p is None else p.found,
@@ -193,8 +195,6 @@ def csv_text(rows: list[Row]) -> str:
 
 def write_tables(out: Path, records: list[dict[str, Any]], plan: CampaignPlan) -> list[Row]:
     """Write ``table.md`` and ``table.csv`` (atomically) from the records; returns the rows."""
-    from cellstress.core.io import atomic_write_text
-
     rows = summarize(records, [c.name for c in plan.cells], [s.name for s in plan.searchers], plan.budget)
     atomic_write_text(out / TABLE_MD, markdown(rows, plan))
     atomic_write_text(out / TABLE_CSV, csv_text(rows))

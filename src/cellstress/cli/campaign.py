@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from cellstress.cli.common import check_out_dir, fail, user_errors
+from cellstress.cli.common import check_out_dir, fail, say, user_errors
 
 INTERRUPTED = 130  # the shell's code for a program stopped by SIGINT
 
@@ -67,12 +67,12 @@ def campaign(
         state["done"] = state["before"] = before
         bar.update(task, completed=before)
         if dropped:
-            typer.echo(f"note: {out_dir / 'runs.jsonl'} ended in a truncated line (a run cut short by a crash); "
+            say(f"note: {out_dir / 'runs.jsonl'} ended in a truncated line (a run cut short by a crash); "
                        "dropped it, the run is done again", err=True)
         if before:
-            typer.echo(f"resuming: {before} of {total} runs already in {out_dir / 'runs.jsonl'}", err=True)
+            say(f"resuming: {before} of {total} runs already in {out_dir / 'runs.jsonl'}", err=True)
         if total > before:
-            typer.echo(f"running {total - before} runs on {how.describe(total - before)}", err=True)
+            say(f"running {total - before} runs on {how.describe(total - before)}", err=True)
 
     def tick(done: int, total: int) -> None:
         state["done"] = done
@@ -82,17 +82,17 @@ def campaign(
         with bar, user_errors():
             outcome = run_campaign(plan, out_dir, how, progress=tick, on_start=started)
     except KeyboardInterrupt:
-        typer.echo(f"interrupted: {state['done']} of {len(plan.runs())} runs are in {out_dir / 'runs.jsonl'}; "
+        say(f"interrupted: {state['done']} of {len(plan.runs())} runs are in {out_dir / 'runs.jsonl'}; "
                    "run the same command again to resume", err=True)
         raise typer.Exit(INTERRUPTED) from None
     except BrokenProcessPool as exc:  # a worker was killed (out of memory, a signal): not the user's fault
-        typer.echo(f"error: a worker process died ({exc}); {state['done']} of {len(plan.runs())} runs are in "
+        say(f"error: a worker process died ({exc}); {state['done']} of {len(plan.runs())} runs are in "
                    f"{out_dir / 'runs.jsonl'}; run the same command again to resume", err=True)
         raise typer.Exit(1) from None
     except OSError as exc:
         raise fail(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
     elapsed = time.perf_counter() - t0
-    typer.echo(markdown(list(outcome.rows), plan), nl=False)
-    typer.echo(f"\n{outcome.total} runs ({outcome.ran} run now, {outcome.done_before} already done) in "
+    say(markdown(list(outcome.rows), plan), nl=False)
+    say(f"\n{outcome.total} runs ({outcome.ran} run now, {outcome.done_before} already done) in "
                f"{elapsed:.1f} s; wrote {out_dir / TABLE_MD}, {out_dir / TABLE_CSV}, "
                f"{out_dir / 'discovery.png'}, {out_dir / 'report.html'}")

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import typer
-
-from cellstress.cli.common import first_sentence
+from cellstress.cli.common import first_sentence, say
 from cellstress.core.errors import CellstressError
 
 
@@ -19,10 +17,10 @@ def cells() -> None:
         try:
             data = yaml.safe_load(builtin_text(name))
         except CellstressError:
-            typer.echo(f"{name:<{width}}  (missing)")
+            say(f"{name:<{width}}  (missing)")
             continue
         except yaml.YAMLError:
-            typer.echo(f"{name:<{width}}  (unreadable YAML: run 'cellstress check {name}')")
+            say(f"{name:<{width}}  (unreadable YAML: run 'cellstress check {name}')")
             continue
         description = data.get("description", "") if isinstance(data, dict) else ""
-        typer.echo(f"{name:<{width}}  {first_sentence(str(description or '')) or '(no description)'}")
+        say(f"{name:<{width}}  {first_sentence(str(description or '')) or '(no description)'}")

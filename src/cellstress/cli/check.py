@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from cellstress.cli.common import CELL_HELP, first_sentence, num, user_errors
+from cellstress.cli.common import CELL_HELP, first_sentence, num, say, user_errors
 
 
 def check(
@@ -40,7 +40,7 @@ def check(
         traj = build_trajectory(task.waypoints_deg, task.dwell, task.speed_scale, robot.velocity_limits)
         static = static_check(c)
 
-    out = typer.echo
+    out = say
     origin = "built-in" if cell in BUILTIN_CELLS else "file"
     out(f"cell        {spec.name}  ({origin}: {c.source}, sha256 {c.sha256[:12]})")
     if spec.description:

@@ -17,15 +17,22 @@ from pathlib import Path
 import typer
 
 from cellstress.core.errors import CellstressError
+from cellstress.core.text import for_terminal
 
 USER_ERROR = 2
 CELL_HELP = "A built-in cell name (see 'cellstress cells') or the path of a cell file."
 
 
+def say(text: str = "", *, err: bool = False, nl: bool = True) -> None:
+    """Print text whose parts may come from files other people wrote: each line with its control characters
+    (terminal escape sequences, bidirectional overrides) shown as escapes, never obeyed."""
+    typer.echo("\n".join(for_terminal(line) for line in str(text).split("\n")), err=err, nl=nl)
+
+
 def fail(message: str) -> typer.Exit:
     """Print ``error: message`` as one line on stderr; the caller raises the returned Exit(2)."""
     one_line = " ".join(str(message).split())
-    typer.echo(f"error: {one_line}", err=True)
+    say(f"error: {one_line}", err=True)
     return typer.Exit(USER_ERROR)
 
 

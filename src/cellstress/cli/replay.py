@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from cellstress.cli.common import HEADER, fail, num, step_line, user_errors
+from cellstress.cli.common import HEADER, fail, num, say, step_line, user_errors
 
 
 def replay(
@@ -40,9 +40,9 @@ def replay(
         c = with_criterion(load_cell(res.cell.source), res.cell.criterion or DEFAULT_CRITERION)
         trace = Simulator(c).run(list(h.actions))
     records = [json_ready(r.model_dump()) for r in trace.records()]
-    typer.echo(HEADER)
+    say(HEADER)
     for r in records:
-        typer.echo(step_line(r))
+        say(step_line(r))
     problems = []
     if c.sha256 != res.cell.sha256:
         problems.append(f"the cell differs from the one searched (sha256 {c.sha256[:12]} != "
@@ -59,7 +59,7 @@ def replay(
         problems.append("the replayed episode does not reach an unsafe state")
     if problems:
         for p in problems:
-            typer.echo(f"MISMATCH: {p}")
+            say(f"MISMATCH: {p}")
         raise typer.Exit(1)
-    typer.echo(f"REPRODUCED bit-exactly: UNSAFE at t={num(h.time_s)} s (step {h.step}): "
+    say(f"REPRODUCED bit-exactly: UNSAFE at t={num(h.time_s)} s (step {h.step}): "
                f"{h.robot_link} / {h.body_part}, v_R {h.v_R:.3f} m/s")

@@ -10,7 +10,7 @@ from typing import Annotated
 
 import typer
 
-from cellstress.cli.common import fail
+from cellstress.cli.common import fail, say
 from cellstress.core.errors import CellstressError
 
 RESULT_HELP = "A result.json written by 'cellstress search' (or its folder)."
@@ -30,11 +30,11 @@ def report(
     except OSError as exc:
         raise fail(f"{result_file}: cannot write the report ({exc.strerror or exc})") from None
     folder = files.html.parent
-    typer.echo(f"report    {files.html}")
-    typer.echo(f"          {', '.join(p.name for p in files.paths[:-1])} in {folder}")
-    typer.echo(f"account   {files.account.headline}")
+    say(f"report    {files.html}")
+    say(f"          {', '.join(p.name for p in files.paths[:-1])} in {folder}")
+    say(f"account   {files.account.headline}")
     if files.cell_changed:
-        typer.echo("warning   the cell file has changed since the search; the pictures show the current cell")
+        say("warning   the cell file has changed since the search; the pictures show the current cell")
 
 
 def show(
@@ -63,7 +63,7 @@ def show(
         raise fail(str(exc)) from None
     except OSError as exc:
         raise fail(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
-    typer.echo(f"wrote     {path}")
+    say(f"wrote     {path}")
 
 
 def after_search(result_path: Path, sim) -> str:

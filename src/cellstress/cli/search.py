@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from cellstress.cli.common import CELL_HELP, check_criterion, check_out_dir, criterion_help, fail, num, user_errors
+from cellstress.cli.common import CELL_HELP, check_criterion, check_out_dir, criterion_help, fail, num, say, user_errors
 from cellstress.core.errors import CellstressError
 
 
@@ -105,13 +105,13 @@ def search(
     rate = result.episodes / max(elapsed, 1e-9)
     report = None if no_report else after_search(path, sim)
     if as_json:
-        typer.echo(result.to_json(), nl=False)
+        say(result.to_json(), nl=False)
         if report:
-            typer.echo(report, err=True)
-        typer.echo(f"{result.episodes} episodes in {elapsed:.2f} s ({rate:.0f} episodes/s); wrote {path}",
+            say(report, err=True)
+        say(f"{result.episodes} episodes in {elapsed:.2f} s ({rate:.0f} episodes/s); wrote {path}",
                    err=True)
         return
-    echo = typer.echo
+    echo = say
     echo(f"cell      {result.cell.name}  searcher {result.searcher} ({_params_text(result.params)})  "
          f"seed {seed}  budget {budget}")
     best = max(result.risk_per_episode, default=0.0)

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from cellstress.cli.common import CELL_HELP, HEADER, check_criterion, criterion_help, num, step_line, user_errors
+from cellstress.cli.common import CELL_HELP, HEADER, check_criterion, criterion_help, num, say, step_line, user_errors
 
 
 def simulate(
@@ -46,15 +46,15 @@ def simulate(
     if as_json:
         doc = {"cell": c.name, "actions": [ACTION_NAMES[i] for i in indices], "steps": records,
                "unsafe": hazard is not None, "hazard": hazard}
-        typer.echo(json.dumps(json_ready(doc), indent=1, allow_nan=False))
+        say(json.dumps(json_ready(doc), indent=1, allow_nan=False))
         return
-    typer.echo(HEADER)
+    say(HEADER)
     for r in records:
-        typer.echo(step_line(r))
+        say(step_line(r))
     if hazard is None:
-        typer.echo("SAFE")
+        say("SAFE")
     else:
-        typer.echo(f"UNSAFE at t={num(hazard['t'])} s (step {hazard['step']}): "
+        say(f"UNSAFE at t={num(hazard['t'])} s (step {hazard['step']}): "
                    f"{hazard['robot_link']} / {hazard['body_part']}")
         if verdict is not None:
-            typer.echo(f"{sim.criterion.type}  {verdict.reason}")
+            say(f"{sim.criterion.type}  {verdict.reason}")

@@ -8,12 +8,14 @@ image and draws the moving things over it (so they lie above every static thing,
 
 from __future__ import annotations
 
+import io
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from PIL import Image
 
+from cellstress.core.io import atomic_write
 from cellstress.report import draw as D
 from cellstress.report.episode import EpisodeView
 from cellstress.report.story import stop_request
@@ -134,8 +136,10 @@ def write_gif(frames: list[np.ndarray], path: str | Path, options: AnimationOpti
     images = [Image.fromarray(f) for f in frames]
     durations = [options.frame_ms] * (len(images) - 1) + [options.last_frame_ms]
     # frames always differ (the time is printed on each), so Pillow keeps every one (it merges identical ones)
-    images[0].save(path, format="GIF", save_all=True, append_images=images[1:], duration=durations, loop=0,
+    buf = io.BytesIO()
+    images[0].save(buf, format="GIF", save_all=True, append_images=images[1:], duration=durations, loop=0,
                    optimize=False, disposal=1)
+    atomic_write(path, buf.getvalue())
     return path
 
 

@@ -112,6 +112,7 @@ def discovery_figure(curves: dict[str, dict[str, np.ndarray]], counts: dict[tupl
     return fig
 
 
+@D.plain_text
 def write_campaign_report(records: Iterable[Mapping], table_text: str, out_dir: str | Path,
                           options: CampaignOptions = CampaignOptions()) -> CampaignFiles:
     """Write ``discovery.png`` and ``report.html`` into ``out_dir``; ``table_text`` is the campaign's table as

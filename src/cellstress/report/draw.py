@@ -7,9 +7,12 @@ reports can be made in parallel processes and on machines without a display.
 
 from __future__ import annotations
 
+import functools
+import io
 from dataclasses import dataclass
 from pathlib import Path
 
+import matplotlib
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import PolyCollection
@@ -17,6 +20,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon, Rectangle
 
+from cellstress.core.io import atomic_write
 from cellstress.sim.build import Layout
 
 # One colour per kind of thing, used by every picture (the legend explains them once).
@@ -52,6 +56,18 @@ class FigureSize:
         return round(self.width * self.dpi), round(self.height * self.dpi)
 
 
+def plain_text(func):
+    """Make ``func``'s pictures with matplotlib's mathtext off: names come from files other people wrote, and a
+    ``$`` in one would be read as mathematics (and a lone one fails the whole picture). Nothing of ours uses it."""
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        with matplotlib.rc_context({"text.parse_math": False}):
+            return func(*args, **kwargs)
+
+    return wrapper
+
+
 def new_figure(size: FigureSize) -> Figure:
     fig = Figure(figsize=(size.width, size.height), dpi=size.dpi)
     FigureCanvasAgg(fig)
@@ -61,7 +77,9 @@ def new_figure(size: FigureSize) -> Figure:
 def save_png(fig: Figure, path: str | Path) -> Path:
     """Save without ``bbox_inches='tight'``, so pixel size and data-to-pixel transform are exactly the figure's."""
     path = Path(path)
-    fig.savefig(path, dpi=fig.dpi, format="png", metadata=PNG_METADATA)
+    buf = io.BytesIO()
+    fig.savefig(buf, dpi=fig.dpi, format="png", metadata=PNG_METADATA)
+    atomic_write(path, buf.getvalue())  # a link planted at the path is replaced, never followed
     return path
 
 

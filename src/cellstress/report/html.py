@@ -8,6 +8,8 @@ import base64
 from html import escape
 from pathlib import Path
 
+from cellstress.core.io import atomic_write_text
+
 _MIME = {".png": "image/png", ".gif": "image/gif", ".mp4": "video/mp4"}
 
 STYLE = """
@@ -78,5 +80,5 @@ def page(title: str, body: list[str], footer: str) -> str:
 
 def write_page(path: str | Path, text: str) -> Path:
     path = Path(path)
-    path.write_text(text, encoding="utf-8", newline="\n")
+    atomic_write_text(path, text)
     return path

@@ -66,6 +66,7 @@ def _simulator(res: SearchResult, sim):
         raise ReportError(f"cannot load the result's cell: {exc}") from None
 
 
+@D.plain_text
 def write_report(result: SearchResult | str | Path, out_dir: str | Path | None = None, *, sim=None,
                  options: ReportOptions = ReportOptions()) -> ReportFiles:
     """Write the report of ``result`` (a SearchResult, a result.json or its folder) into ``out_dir`` (default:
@@ -120,14 +121,15 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
     body = [f"<h1>cellstress report: {H.escape(cell)}</h1>"]
     if res.found:
         h = res.hazard
-        verdict = (f"<b>Hazard found</b> at episode {h.episode} of {res.budget} ({res.searcher}, seed {res.seed}): "
-                   f"{H.escape(str(h.robot_link))} / {H.escape(str(h.body_part))} at t = {h.time_s:.2f} s, "
+        e = H.escape
+        verdict = (f"<b>Hazard found</b> at episode {h.episode} of {res.budget} ({e(res.searcher)}, seed "
+                   f"{res.seed}): {e(str(h.robot_link))} / {e(str(h.body_part))} at t = {h.time_s:.2f} s, "
                    f"v_R = {h.v_R:.2f} m/s.")
         body.append(f'<div class="verdict hazard">{verdict}</div>')
     else:
         body.append(f'<div class="verdict safe"><b>No hazard found</b> in {res.episodes} episodes '
-                    f"({res.searcher}, seed {res.seed}). The riskiest episode kept (episode {view.episode}) is shown "
-                    f"instead.</div>")
+                    f"({H.escape(res.searcher)}, seed {res.seed}). The riskiest episode kept (episode "
+                    f"{view.episode}) is shown instead.</div>")
     if cell_changed:
         body.append('<p class="warn">The cell file has changed since the search (sha256 differs): the pictures '
                     "show the episode replayed in the current cell.</p>")
@@ -183,6 +185,7 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
                   f"(searcher {res.searcher}, seed {res.seed}). Replay: cellstress replay {FILE_NAME}")
 
 
+@D.plain_text
 def show_cell(cell, out: str | Path, size: D.FigureSize | None = None) -> Path:
     """Draw a cell's layout (``cellstress show``) into a PNG file."""
     from cellstress.cell.load import load_cell

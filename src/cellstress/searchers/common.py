@@ -150,12 +150,27 @@ def rollout(problem, reward, state, actions: list[int], risk: float, rng: np.ran
     return total, risk, False
 
 
+MAX_BUDGET = 10_000_000  # episodes: every search keeps a risk per episode, so memory grows with the budget
+MAX_TOP_K = 100_000
+MAX_SEED = 2**63 - 1
+
+
+def whole(name: str, value, lo: int, hi: int) -> None:
+    """SearchError unless ``value`` is a whole number in lo..hi (``True`` is not a number)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= value <= hi:
+        raise SearchError(f"{name} must be a whole number in {lo}..{hi:,}, not {value!r}")
+
+
+def number(name: str, value, lo: float, hi: float) -> None:
+    """SearchError unless ``value`` is a number in lo..hi (finite; ``True`` is not a number)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not lo <= value <= hi:
+        raise SearchError(f"{name} must be a number in {lo:g}..{hi:g}, not {value!r}")
+
+
 def check_common(budget, seed, until, top_k) -> None:
-    if isinstance(budget, bool) or not isinstance(budget, (int, np.integer)) or budget < 1:
-        raise SearchError(f"budget must be a whole number of episodes >= 1, not {budget!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise SearchError(f"seed must be a whole number >= 0, not {seed!r}")
+    whole("budget", budget, 1, MAX_BUDGET)
+    whole("seed", seed, 0, MAX_SEED)
     if until not in UNTIL:
         raise SearchError(f"until must be one of {', '.join(UNTIL)}, not {until!r}")
-    if isinstance(top_k, bool) or not isinstance(top_k, (int, np.integer)) or top_k < 0:
-        raise SearchError(f"top_k must be a whole number >= 0, not {top_k!r}")
+    whole("top_k", top_k, 0, MAX_TOP_K)

@@ -64,7 +64,7 @@ from typing import ClassVar
 import numpy as np
 
 from cellstress.core.protocols import CellRows, Lookahead, NoveltyAware, SafetyIndexReward
-from cellstress.searchers.common import Recorder, SearchError
+from cellstress.searchers.common import MAX_BUDGET, Recorder, SearchError, number, whole
 from cellstress.sim.layout import M_D, M_PHASE, M_V, PHASE_RUNNING
 
 EVOLVE_KEY = 3
@@ -101,27 +101,20 @@ class Evolve:
     color: ClassVar[str | None] = "#2ca02c"
 
     def __post_init__(self):
-        for k, lo in (("n_init", 1), ("pool", 1), ("patience", 0)):
-            v = getattr(self, k)
-            if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-                raise SearchError(f"{k} must be a whole number >= {lo}, not {v!r}")
+        whole("n_init", self.n_init, 1, 1_000_000)
+        whole("pool", self.pool, 1, 100_000)
+        whole("patience", self.patience, 0, MAX_BUDGET)
         for k in ("keep_tail", "sticky", "focus"):
-            v = getattr(self, k)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= v <= 1.0:
-                raise SearchError(f"{k} must be a number in 0..1, not {v!r}")
+            number(k, getattr(self, k), 0.0, 1.0)
         parts = ALIASES.get(self.score, self.score).split("+") if isinstance(self.score, str) else [None]
         if not set(parts) <= set(SCORES) or len(set(parts)) != len(parts):
             raise SearchError(f"score must be {', '.join(SCORES)} or several of them joined by '+' "
                               f"({', '.join(ALIASES)} are short for {', '.join(ALIASES.values())}), not {self.score!r}")
-        if self.init_sticky is not None and (isinstance(self.init_sticky, bool)
-                                             or not isinstance(self.init_sticky, (int, float))
-                                             or not 0.0 <= self.init_sticky <= 1.0):
-            raise SearchError(f"init_sticky must be a number in 0..1 or null, not {self.init_sticky!r}")
-        for k, v in (("horizon", self.horizon), ("speed", self.speed)):
-            if v is None and k == "horizon":
-                continue
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= v < math.inf:
-                raise SearchError(f"{k} must be a number >= 0, not {v!r}")
+        if self.init_sticky is not None:
+            number("init_sticky", self.init_sticky, 0.0, 1.0)
+        if self.horizon is not None:
+            number("horizon", self.horizon, 0.0, 60.0)
+        number("speed", self.speed, 0.0, 10.0)
 
     @property
     def uses(self) -> tuple[int, ...]:

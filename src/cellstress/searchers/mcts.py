@@ -27,7 +27,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-from cellstress.searchers.common import Recorder, SearchError
+from cellstress.searchers.common import Recorder, SearchError, number
 from cellstress.searchers.tree import Tree
 
 
@@ -55,8 +55,8 @@ class MCTS:
 
 
 def check_dpw(ec, k, alpha) -> None:
-    for name, v in (("ec", ec), ("k", k), ("alpha", alpha)):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not v == v or v < 0 or v == float("inf"):
-            raise SearchError(f"{name} must be a finite number >= 0, not {v!r}")
+    number("ec", ec, 0.0, 1e6)
+    number("k", k, 0.0, 1e3)
+    number("alpha", alpha, 0.0, 2.0)
     if k == 0:
         raise SearchError("k must be > 0 (with k = 0 the root never widens)")

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-from cellstress.searchers.common import Recorder, SearchError
+from cellstress.searchers.common import MAX_BUDGET, Recorder, whole
 from cellstress.searchers.mcts import check_dpw
 from cellstress.searchers.tree import Tree
 
@@ -36,8 +36,8 @@ class MCTSCommit:
 
     def __post_init__(self):
         check_dpw(self.ec, self.k, self.alpha)
-        if self.n is not None and (isinstance(self.n, bool) or not isinstance(self.n, int) or self.n < 1):
-            raise SearchError(f"n must be a whole number of iterations >= 1, not {self.n!r}")
+        if self.n is not None:
+            whole("n", self.n, 1, MAX_BUDGET)
 
     def iterations(self, budget: int, horizon: int) -> list[int]:
         if self.n is not None:

@@ -58,7 +58,7 @@ from typing import ClassVar
 import numpy as np
 
 from cellstress.core.protocols import WorkerModel
-from cellstress.searchers.common import Recorder, SearchError
+from cellstress.searchers.common import Recorder, SearchError, number, whole
 from cellstress.searchers.evolve import REDRAWS
 from cellstress.sim import kernels as K
 
@@ -89,14 +89,11 @@ class Plan:
     color: ClassVar[str | None] = "#9467bd"
 
     def __post_init__(self):
-        for k, lo in (("n_init", 1), ("candidates", 1), ("pool", 1)):
-            v = getattr(self, k)
-            if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-                raise SearchError(f"{k} must be a whole number >= {lo}, not {v!r}")
+        whole("n_init", self.n_init, 1, 1_000_000)
+        whole("candidates", self.candidates, 1, 100_000)  # each is a worker path predicted per episode
+        whole("pool", self.pool, 1, 10_000)
         for k in ("init_sticky", "explore", "sticky", "keep_tail"):
-            v = getattr(self, k)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= v <= 1.0:
-                raise SearchError(f"{k} must be a number in 0..1, not {v!r}")
+            number(k, getattr(self, k), 0.0, 1.0)
 
     def run(self, problem, reward, rec: Recorder, seed: int) -> None:
         if not isinstance(problem, WorkerModel):

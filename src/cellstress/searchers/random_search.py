@@ -15,7 +15,7 @@ import numpy as np
 
 from cellstress.core.protocols import BatchSimulator
 from cellstress.core.records import Measures
-from cellstress.searchers.common import Recorder, SearchError, rollout
+from cellstress.searchers.common import Recorder, rollout, whole
 
 RANDOM_KEY = 2
 
@@ -35,8 +35,7 @@ class RandomSearch:
     color: ClassVar[str | None] = "#7f7f7f"
 
     def __post_init__(self):
-        if isinstance(self.chunk, bool) or not isinstance(self.chunk, int) or self.chunk < 1:
-            raise SearchError(f"chunk must be a whole number >= 1, not {self.chunk!r}")
+        whole("chunk", self.chunk, 1, 100_000)
 
     def run(self, problem, reward, rec: Recorder, seed: int) -> None:
         rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(RANDOM_KEY,)))
