@@ -59,7 +59,7 @@ def test_replay_detects_a_changed_trace(tmp_path, capsys) -> None:
     path.write_text(json.dumps(doc))
     code, out, _ = _run(["replay", str(path)], capsys)
     assert code == 1
-    assert f"MISMATCH: row {len(doc['hazard']['trace']) - 2} differs in d_HR" in out
+    assert f"MISMATCH: hazard.trace[{len(doc['hazard']['trace']) - 2}].d_HR: the file says" in out
 
 
 def test_replay_detects_a_changed_cell(tmp_path, capsys) -> None:
@@ -69,7 +69,57 @@ def test_replay_detects_a_changed_cell(tmp_path, capsys) -> None:
     doc["cell"]["sha256"] = "0" * 64
     path.write_text(json.dumps(doc))
     code, out, _ = _run(["replay", str(path)], capsys)
-    assert code == 1 and "MISMATCH: the cell differs" in out
+    assert code == 1 and "MISMATCH: cell.sha256: the cell differs" in out
+
+
+@pytest.fixture(scope="module")
+def plan_result(tmp_path_factory) -> dict:
+    out = tmp_path_factory.mktemp("plan")
+    assert main(["search", "s3-fence-gap", "--searcher", "plan", "--budget", "40", "--out", str(out),
+                 "--no-report"]) == 0
+    return json.loads((out / "result.json").read_text())
+
+
+@pytest.mark.parametrize(("field", "value", "named"), [
+    ("hazard.time_s", 0.5, "hazard.time_s"),
+    ("hazard.step", 3, "hazard.step"),
+    ("hazard.robot_link", "wrist_1_link", "hazard.robot_link"),
+    ("hazard.body_part", "head", "hazard.body_part"),
+    ("hazard.v_R", 0.01, "hazard.v_R"),
+    ("hazard.d_HR", 0.2, "hazard.d_HR"),
+    ("hazard.point", [0.0, 0.0, 0.0], "hazard.point[0]"),
+    ("hazard.episode", 40, "hazard.episode"),
+    ("seed", 7, "the search run again (searcher plan, seed 7"),
+    ("found", False, "found"),
+    ("episodes", 39, "episodes"),
+    ("risk_per_episode", [0.5], "risk_per_episode"),
+])
+def test_replay_recomputes_every_claim(plan_result, tmp_path, capsys, field, value, named) -> None:
+    """A forged value anywhere in the file is a MISMATCH that names it, never 'REPRODUCED'."""
+    doc = json.loads(json.dumps(plan_result))
+    *parents, last = field.split(".")
+    node = doc
+    for p in parents:
+        node = node[p]
+    assert node[last] != value
+    node[last] = value
+    (tmp_path / "result.json").write_text(json.dumps(doc))
+    code, out, err = _run(["replay", str(tmp_path / "result.json")], capsys)
+    assert code == 1, err
+    assert "REPRODUCED" not in out
+    mismatches = [line for line in out.splitlines() if line.startswith("MISMATCH: ")]
+    assert mismatches and named in mismatches[0], out
+
+
+def test_replay_unforged_and_no_search(plan_result, tmp_path, capsys) -> None:
+    (tmp_path / "result.json").write_text(json.dumps(plan_result))
+    code, out, _ = _run(["replay", str(tmp_path / "result.json")], capsys)
+    assert code == 0 and "REPRODUCED bit-exactly" in out and "the search run again gives the same file" in out
+    doc = json.loads(json.dumps(plan_result))
+    doc["seed"] = 7  # not checked without the search, and the line says so
+    (tmp_path / "result.json").write_text(json.dumps(doc))
+    code, out, _ = _run(["replay", str(tmp_path / "result.json"), "--no-search"], capsys)
+    assert code == 0 and "the search was not run again (--no-search)" in out
 
 
 def test_replay_without_hazard_or_file_is_a_user_error(tmp_path, capsys) -> None:

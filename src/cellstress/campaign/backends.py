@@ -20,6 +20,8 @@ from cellstress.campaign.worker import execute, execute_threaded, init_worker
 
 BACKENDS = ("processes", "ray")
 RAY_HINT = "pip install 'cellstress[ray]'"
+MAX_LOCAL_WORKERS_PER_CORE = 4  # each is a process with its own compiled simulators (a few hundred MB)
+MAX_RAY_TASKS = 100_000
 
 
 def cpu_count() -> int:
@@ -42,9 +44,11 @@ class Backend:
     def __post_init__(self) -> None:
         if self.name not in BACKENDS:
             raise CampaignError(f"--backend must be one of {', '.join(BACKENDS)}, not {self.name!r}")
+        most = MAX_RAY_TASKS if self.name == "ray" else MAX_LOCAL_WORKERS_PER_CORE * cpu_count()
         if self.workers is not None and (isinstance(self.workers, bool) or not isinstance(self.workers, int)
-                                         or self.workers < 1):
-            raise CampaignError(f"--workers must be a whole number >= 1, not {self.workers!r}")
+                                         or not 1 <= self.workers <= most):
+            raise CampaignError(f"--workers must be a whole number in 1..{most} (each local worker is a process "
+                                f"of its own), not {self.workers!r}")
         if self.address is not None and self.name != "ray":
             raise CampaignError("--address is the address of a Ray cluster: use it with --backend ray")
 

@@ -19,6 +19,7 @@ from cellstress.core import registry
 from cellstress.core.errors import CellstressError
 from cellstress.core.version import __version__
 from cellstress.searchers import make_searcher, searcher_class, searcher_names
+from cellstress.searchers.common import MAX_BUDGET
 
 FORMAT = 1
 MANIFEST = "campaign.json"
@@ -125,6 +126,10 @@ def split_names(values: list[str] | tuple[str, ...] | None, default: tuple[str, 
     return names
 
 
+MAX_SEEDS = 100_000  # every run is a line of runs.jsonl and a row of the plan held in memory
+MAX_CELLS = 100
+
+
 def resolve(cells: tuple[str, ...], searchers: tuple[str, ...], seeds: int, budget: int,
             options: dict[str, Any] | None = None) -> CampaignPlan:
     """Check the options and pin them: load every cell (its hash) and fill in each searcher's defaults.
@@ -132,9 +137,11 @@ def resolve(cells: tuple[str, ...], searchers: tuple[str, ...], seeds: int, budg
 
     Raises ``CampaignError`` (or the cell's ``CellError``) for anything the user must fix."""
 
-    for opt, value in (("seeds", seeds), ("budget", budget)):
-        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise CampaignError(f"--{opt} must be a whole number >= 1, not {value!r}")
+    for opt, value, most in (("seeds", seeds, MAX_SEEDS), ("budget", budget, MAX_BUDGET)):
+        if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= most:
+            raise CampaignError(f"--{opt} must be a whole number in 1..{most:,}, not {value!r}")
+    if len(cells) > MAX_CELLS or len(searchers) > MAX_CELLS:
+        raise CampaignError(f"at most {MAX_CELLS} cells and {MAX_CELLS} searchers in one campaign")
     known = searcher_names()
     unknown = [s for s in searchers if s not in known]
     if unknown:

@@ -6,9 +6,7 @@ from typing import Annotated
 
 import typer
 
-from cellstress.cli.common import check_out_dir, fail, say, user_errors
-
-INTERRUPTED = 130  # the shell's code for a program stopped by SIGINT
+from cellstress.cli.common import INTERRUPTED, check_out_dir, fail, say, user_errors
 
 
 def campaign(

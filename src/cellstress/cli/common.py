@@ -20,6 +20,7 @@ from cellstress.core.errors import CellstressError
 from cellstress.core.text import for_terminal
 
 USER_ERROR = 2
+INTERRUPTED = 130  # the shell's code for a program stopped by SIGINT
 CELL_HELP = "A built-in cell name (see 'cellstress cells') or the path of a cell file."
 
 

@@ -12,6 +12,7 @@ import typer
 
 from cellstress.cli.common import fail, say
 from cellstress.core.errors import CellstressError
+from cellstress.core.text import slug
 
 RESULT_HELP = "A result.json written by 'cellstress search' (or its folder)."
 
@@ -40,8 +41,8 @@ def report(
 def show(
     cell: Annotated[str, typer.Argument(help="A built-in cell name (see 'cellstress cells') or the path of a "
                                         "cell file.")],
-    out: Annotated[str | None, typer.Option("--out", "-o", help="PNG file to write (default: CELLNAME.png in "
-                                            "the current folder).")] = None,
+    out: Annotated[str | None, typer.Option("--out", "-o", help="PNG file to write (default: the cell's name "
+                                            "as a plain file name, .png, in the current folder).")] = None,
 ) -> None:
     """Draw a cell's layout to scale (fences, table, devices, the robot's swept area, the start) as a PNG."""
     from cellstress.cell.load import load_cell
@@ -50,7 +51,7 @@ def show(
         c = load_cell(cell)
     except CellstressError as exc:
         raise fail(str(exc)) from None
-    path = Path(out) if out is not None else Path(f"{c.spec.name}.png")
+    path = Path(out) if out is not None else Path(f"{slug(c.spec.name)}.png")
     if path.suffix.lower() != ".png":
         raise fail(f"--out {out}: the picture is a PNG file, give a name ending in .png")
     from cellstress.report.make import show_cell

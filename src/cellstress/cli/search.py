@@ -6,7 +6,17 @@ from typing import Annotated
 
 import typer
 
-from cellstress.cli.common import CELL_HELP, check_criterion, check_out_dir, criterion_help, fail, num, say, user_errors
+from cellstress.cli.common import (
+    CELL_HELP,
+    INTERRUPTED,
+    check_criterion,
+    check_out_dir,
+    criterion_help,
+    fail,
+    num,
+    say,
+    user_errors,
+)
 from cellstress.core.errors import CellstressError
 
 
@@ -90,13 +100,21 @@ def search(
     task = progress.add_task(searcher, total=budget, rate=0.0, risk=0.0)
     t0 = time.perf_counter()
 
+    played = [0]
+
     def tick(done: int, best_risk: float) -> None:
+        played[0] = done
         if done % 8 == 0 or done == budget:
             progress.update(task, completed=done, rate=done / max(time.perf_counter() - t0, 1e-9), risk=best_risk)
 
-    with progress, user_errors():
-        result = run(sim, searcher, budget, seed, until=until, top_k=top_k, progress=tick, distinct=distinct,
-                     **options)
+    try:
+        with progress, user_errors():
+            result = run(sim, searcher, budget, seed, until=until, top_k=top_k, progress=tick, distinct=distinct,
+                         **options)
+    except KeyboardInterrupt:
+        say(f"interrupted after {played[0]} of {budget} episodes; nothing was written to {out_dir} (a search "
+            "is replayable only whole: run the same command again)", err=True)
+        raise typer.Exit(INTERRUPTED) from None
     elapsed = time.perf_counter() - t0
     try:
         path = result.write(out_dir)

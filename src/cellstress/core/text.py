@@ -42,3 +42,15 @@ def for_markdown(text: str) -> str:
 def for_plot(text: str) -> str:
     """Text for a matplotlib label or title: ``$`` escaped (mathtext), control characters shown as escapes."""
     return for_terminal(text).replace("$", r"\$")
+
+
+_UNSAFE_IN_FILE_NAME = re.compile(r"[^A-Za-z0-9._-]+")
+MAX_SLUG = 80
+
+
+def slug(text: str, fallback: str = "cell") -> str:
+    """A file name made from a name someone else chose: letters, digits, ``. _ -`` only, no leading dot or dash,
+    at most ``MAX_SLUG`` characters, so that it names a file in the working folder and never a path
+    (``../../x`` -> ``x``, ``/etc/passwd`` -> ``etc-passwd``)."""
+    s = _UNSAFE_IN_FILE_NAME.sub("-", str(text)).strip(".-")[:MAX_SLUG].strip(".-")
+    return s or fallback

@@ -15,14 +15,16 @@ image (y -> -y), so one field serves both.
 from __future__ import annotations
 
 import hashlib
+import io
 import os
-import tempfile
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 from numba import njit
+
+from cellstress.core.io import atomic_write
 
 # Ranges of motion [deg] (AAOS normal values): flexion 180 / extension 60, abduction 180 / adduction 30,
 # internal rotation 70 / external rotation 90, elbow flexion 0..150, wrist flexion 80 / extension 70.
@@ -34,7 +36,7 @@ WRIST_FLEXION = (-70.0, 80.0)
 JOINT_RANGES_DEG = np.array([SHOULDER_FLEXION, SHOULDER_ABDUCTION, UPPER_ARM_ROTATION, ELBOW_FLEXION, WRIST_FLEXION])
 
 GRID_SPACING = 0.02  # m
-_CACHE_VERSION = 2  # 2: upper-arm rotation sampled every 10 deg (was 20: gaps of up to 2.5 voxels)
+_CACHE_VERSION = 3  # 2: upper-arm rotation sampled every 10 deg (was 20: gaps of up to 2.5 voxels); 3: a checksum
 
 
 @njit(cache=True)
@@ -139,9 +141,7 @@ def _build(lengths: tuple[float, float, float], spacing: float) -> ReachField:
     from scipy import ndimage
 
     reach = float(sum(lengths))
-    half = reach + 3 * spacing
-    n = int(np.ceil(2 * half / spacing)) + 1
-    origin = -0.5 * (n - 1) * spacing
+    n, origin = _grid(lengths, spacing)
     occupied = np.zeros((n, n, n), dtype=np.bool_)
     lengths_arr = np.asarray(lengths, dtype=float)
     # The whole workspace at a coarse joint step, then the outer shell (straight elbow and wrist, where the
@@ -161,6 +161,13 @@ def _build(lengths: tuple[float, float, float], spacing: float) -> ReachField:
     return ReachField(sdf, origin, spacing, reach)
 
 
+def _grid(lengths: tuple[float, float, float], spacing: float) -> tuple[int, float]:
+    """Nodes per axis and the first node's coordinate of the field's cube grid (3 voxels beyond full reach)."""
+    half = float(sum(lengths)) + 3 * spacing
+    n = int(np.ceil(2 * half / spacing)) + 1
+    return n, -0.5 * (n - 1) * spacing
+
+
 def _cache_dir() -> Path | None:
     root = os.environ.get("CELLSTRESS_CACHE") or os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     path = Path(root) / "cellstress"
@@ -171,27 +178,55 @@ def _cache_dir() -> Path | None:
     return path
 
 
+def _checksum(values: np.ndarray) -> str:
+    return hashlib.sha256(np.ascontiguousarray(values).tobytes()).hexdigest()
+
+
+def _load_cached(file: Path, lengths: tuple[float, float, float], spacing: float) -> ReachField | None:
+    """The cached field, or None unless the file is exactly what ``_build`` would give for these lengths: the
+    cache folder is writable by anyone who runs as the user, so a damaged or edited file must not change a
+    result. Its shape, dtype, grid, arm length and the checksum of its values are all checked, pickles are
+    refused, and a file larger than the field could be is not read."""
+    n, origin = _grid(lengths, spacing)
+    try:
+        if not file.is_file() or file.stat().st_size > 4 * n**3 + 65536:
+            return None
+        with np.load(file, allow_pickle=False) as z:
+            if set(z.files) != {"values", "origin", "spacing", "arm_length", "sha256"}:
+                return None
+            values = z["values"]
+            meta = [z[k] for k in ("origin", "spacing", "arm_length", "sha256")]
+        if values.dtype != np.float32 or values.shape != (n, n, n) or any(m.shape != () for m in meta):
+            return None
+        if (float(meta[0]), float(meta[1]), float(meta[2])) != (origin, spacing, float(sum(lengths))):
+            return None
+        if str(meta[3]) != _checksum(values) or not np.isfinite(values).all():
+            return None
+        return ReachField(values, origin, spacing, float(sum(lengths)))
+    except (OSError, ValueError, KeyError, EOFError, TypeError):
+        return None  # a damaged entry is rebuilt
+
+
 @lru_cache(maxsize=4)
 def reach_field(upper_arm: float, forearm: float, hand: float, spacing: float = GRID_SPACING) -> ReachField:
-    """The field for these segment lengths, built once and kept in memory and in a disk cache."""
+    """The field for these segment lengths, built once and kept in memory and in a disk cache (checked before
+    use, rebuilt when it does not check out)."""
+    lengths = (upper_arm, forearm, hand)
     key = hashlib.sha256(repr((_CACHE_VERSION, upper_arm, forearm, hand, spacing,
                                JOINT_RANGES_DEG.tolist())).encode()).hexdigest()[:16]
     cache = _cache_dir()
     file = cache / f"reach-{key}.npz" if cache else None
-    if file is not None and file.exists():
-        try:
-            with np.load(file) as z:
-                return ReachField(z["values"], float(z["origin"]), float(z["spacing"]), float(z["arm_length"]))
-        except (OSError, ValueError, KeyError):
-            pass  # a damaged cache entry is rebuilt below
-    field = _build((upper_arm, forearm, hand), spacing)
     if file is not None:
+        cached = _load_cached(file, lengths, spacing)
+        if cached is not None:
+            return cached
+    field = _build(lengths, spacing)
+    if file is not None:
+        buf = io.BytesIO()
+        np.savez(buf, values=field.values, origin=field.origin, spacing=field.spacing,
+                 arm_length=field.arm_length, sha256=_checksum(field.values))
         try:
-            fd, tmp = tempfile.mkstemp(dir=file.parent, suffix=".npz")
-            with os.fdopen(fd, "wb") as fh:
-                np.savez(fh, values=field.values, origin=field.origin, spacing=field.spacing,
-                         arm_length=field.arm_length)
-            os.replace(tmp, file)
+            atomic_write(file, buf.getvalue())
         except OSError:
             pass
     return field

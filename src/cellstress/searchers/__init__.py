@@ -42,8 +42,9 @@ from cellstress.sim.simulator import Simulator
 DEFAULT_BUDGET = 200
 DEFAULT_TOP_K = 10
 
-__all__ = ["UNTIL", "Episode", "Outcome", "Recorder", "SearchError", "SearchResult", "make_searcher",
-           "parse_options", "run_search", "search", "searcher_class", "searcher_names"]
+__all__ = ["UNTIL", "Episode", "Outcome", "Recorder", "SearchError", "SearchResult", "distinct_record",
+           "hazard_record", "make_searcher", "parse_options", "run_search", "search", "searcher_class",
+           "searcher_names"]
 
 
 def searcher_names() -> tuple[str, ...]:
@@ -151,21 +152,8 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
         def names(actions):
             return [ACTION_NAMES[a] for a in actions]
 
-    def unsafe_trace(actions):
-        trace = sim.run(names(actions))
-        return trace, trace.records()
-
-    hazard = None
     first = out.first_hazard
-    if first is not None:
-        trace, records = unsafe_trace(first.actions)
-        hit = records[trace.unsafe_row]
-        verdict = sim.verdict(trace.rows[trace.unsafe_row])  # a criterion that judges contacts: its account
-        hazard = Hazard.model_construct(
-            episode=first.index, actions=tuple(names(first.actions)), step=hit.step, time_s=hit.t,
-            robot_link=hit.robot_link, body_part=hit.body_part, point=hit.robot_point, human_point=hit.human_point,
-            v_R=hit.v_R, d_HR=hit.d_HR, trace=records,
-            **({} if verdict is None else {sim.criterion.type: verdict.as_dict()}))
+    hazard = None if first is None else hazard_record(sim, first.index, names(first.actions))
     # a cell file by its absolute path, so that `cellstress replay` works from any folder
     source = c.source if c.directory is None else str(Path(c.source).expanduser().resolve())
     crit = c.spec.criterion.type
@@ -187,16 +175,35 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
         risk_per_episode=tuple(out.risks),
         version=__version__,
         format=FORMAT,
-        distinct=None if rec is None else _distinct_list(rec.classes, names, unsafe_trace),
+        distinct=None if rec is None else tuple(
+            distinct_record(sim, hazard_class_record(key), episode, names(actions))
+            for key, (episode, actions) in rec.classes.items()),
     )
 
 
-def _distinct_list(classes, names, unsafe_trace) -> tuple[DistinctHazard, ...]:
-    out = []
-    for key, (episode, actions) in classes.items():
-        trace, records = unsafe_trace(actions)
-        hit = records[trace.unsafe_row]
-        out.append(DistinctHazard.model_construct(
-            klass=hazard_class_record(key), episode=episode, actions=tuple(names(actions)), step=hit.step,
-            time_s=hit.t, robot_link=hit.robot_link, body_part=hit.body_part, v_R=hit.v_R, trace=records))
-    return tuple(out)
+def _unsafe_row(sim: Simulator, actions: list[str]):
+    trace = sim.run(actions)
+    if trace.unsafe_row is None:
+        raise SearchError(f"the episode {', '.join(actions)} does not reach an unsafe state")
+    return trace, trace.records()
+
+
+def hazard_record(sim: Simulator, episode: int, actions: list[str]) -> Hazard:
+    """The first hazard's record: ``actions`` (names) replayed in ``sim``, summarised at the unsafe step. The
+    search writes it, and ``replay`` makes it again to check every claim of a result file."""
+    trace, records = _unsafe_row(sim, actions)
+    hit = records[trace.unsafe_row]
+    verdict = sim.verdict(trace.rows[trace.unsafe_row])  # a criterion that judges contacts: its account
+    return Hazard.model_construct(
+        episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.t, robot_link=hit.robot_link,
+        body_part=hit.body_part, point=hit.robot_point, human_point=hit.human_point, v_R=hit.v_R, d_HR=hit.d_HR,
+        trace=records, **({} if verdict is None else {sim.criterion.type: verdict.as_dict()}))
+
+
+def distinct_record(sim: Simulator, klass, episode: int, actions: list[str]) -> DistinctHazard:
+    """The record of a distinct class's first hazard (see ``hazard_record``)."""
+    trace, records = _unsafe_row(sim, actions)
+    hit = records[trace.unsafe_row]
+    return DistinctHazard.model_construct(
+        klass=klass, episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.t,
+        robot_link=hit.robot_link, body_part=hit.body_part, v_R=hit.v_R, trace=records)
