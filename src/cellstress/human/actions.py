@@ -52,11 +52,16 @@ def action_index(action: int | str) -> int:
     raise ActionError(f"an action is a name or an index, not {type(action).__name__}")
 
 
+MAX_SEQUENCE = 1000  # actions in one played sequence (200 s): its trace is held in memory and printed
+
+
 def parse_actions(text: str) -> list[int]:
     """Parse a comma-separated action list such as ``walk+upright,walk+bend-forward``."""
     parts = [p for p in (s.strip() for s in text.split(",")) if p]
     if not parts:
         raise ActionError("the action list is empty")
+    if len(parts) > MAX_SEQUENCE:
+        raise ActionError(f"{len(parts):,} actions; at most {MAX_SEQUENCE:,} in one sequence")
     return [action_index(p) for p in parts]
 
 

@@ -1,0 +1,474 @@
+"""Hostile inputs: cell files, result files, options and names that other people might send.
+
+Each case runs the command line in a process of its own, under a time limit and an address-space limit, in a
+working folder of its own. Each asserts the exit code (2 for a bad input, with exactly one line on stderr
+that starts with ``error:``; 1 for a result file whose claims do not hold; 0 for a strange but valid input),
+no traceback, nothing created or changed outside the output folder, and text escaped for where it lands
+(terminal, HTML, CSV, Markdown).
+
+The cases are samples of kinds (files that are not files, bombs, deep nesting, numbers out of range, lax
+types, forged results, names that try to become paths or markup); the code under test handles the kind, not
+the sample. All cases run once, two at a time, in a module fixture; each test then checks one case.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+import subprocess
+import sys
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import pytest
+import yaml
+
+from cellstress.cli import main
+
+TIME_LIMIT = 300  # s per process: generous for a loaded CI machine; a hang is what it catches
+MEMORY_LIMIT = 6 * 2**30  # bytes of address space per process
+# One process per input: it runs each command that reads the input in turn, each with its own stdout and
+# stderr, and reports exit codes (a crash of the command itself shows as a traceback in its stderr).
+CHILD = f"""
+import contextlib, io, json, resource, sys, traceback
+resource.setrlimit(resource.RLIMIT_AS, ({MEMORY_LIMIT}, {MEMORY_LIMIT}))
+from cellstress.cli import main
+done = []
+for argv in json.load(open(sys.argv[1])):
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main(argv)
+        except SystemExit as exc:
+            code = exc.code
+        except BaseException:
+            traceback.print_exc()
+            code = -1
+    done.append({{"code": code, "out": out.getvalue(), "err": err.getvalue()}})
+json.dump(done, open(sys.argv[2], "w"))
+"""
+CELL, RESULT = "in/cell.yaml", "out/result.json"
+SEARCH = ("search", CELL, "--budget", "2", "--searcher", "random", "--out", "out", "--no-report")
+CELL_COMMANDS = {
+    "check": ("check", CELL),
+    "search": SEARCH,
+    "simulate": ("simulate", CELL, "--actions", "walk+upright"),
+    "show": ("show", CELL, "--out", "out/cell.png"),
+    "campaign": ("campaign", "--cells", CELL, "--searchers", "random", "--seeds", "1", "--budget", "2",
+                 "--workers", "1", "--out", "out"),
+}
+
+
+@dataclass(frozen=True)
+class Case:
+    id: str
+    argv: tuple[str, ...]
+    code: int = 2
+    says: tuple[str, ...] = ()  # words of the error line (exit 2), of a MISMATCH line (exit 1)
+    cell: Callable[[dict], object] | None = None  # a change of the baseline, written to in/cell.yaml
+    cell_bytes: bytes | None = None  # or the file's bytes
+    result: Callable[[dict], object] | None = None  # a change of a real result file, written to out/
+    result_bytes: bytes | None = None
+    setup: Callable[[Path], object] | None = None  # anything else, in the case's folder
+    group: str = ""  # cases of one group share a folder and a process (default: the case alone)
+    check: Callable[[Path, str, str], object] | None = None  # more assertions: (folder, stdout, stderr)
+    creates: tuple[str, ...] = ()  # files the command may create outside out/
+
+
+def _set(path: str, value) -> Callable[[dict], None]:
+    """A change that sets one field, ``a.b[2].c`` style."""
+
+    def change(doc: dict) -> None:
+        keys = [int(k) if k.isdigit() else k for k in path.replace("[", ".").replace("]", "").split(".")]
+        node = doc
+        for k in keys[:-1]:
+            node = node[k] if isinstance(k, int) else node.setdefault(k, {})
+        node[keys[-1]] = value
+
+    return change
+
+
+def _delete(path: str) -> Callable[[dict], None]:
+    def change(doc: dict) -> None:
+        *parents, last = path.split(".")
+        node = doc
+        for k in parents:
+            node = node[k]
+        del node[last]
+
+    return change
+
+
+def _fifo(rel: str) -> Callable[[Path], None]:
+    def setup(folder: Path) -> None:
+        (folder / rel).parent.mkdir(parents=True, exist_ok=True)
+        os.mkfifo(folder / rel)
+
+    return setup
+
+
+def _link(rel: str, target: str) -> Callable[[Path], None]:
+    def setup(folder: Path) -> None:
+        (folder / rel).parent.mkdir(parents=True, exist_ok=True)
+        os.symlink(target, folder / rel)
+
+    return setup
+
+
+def _big_polygon(n: int) -> Callable[[dict], None]:
+    def change(cell: dict) -> None:
+        import math
+
+        cell["table"]["polygons"] = [[[0.3 * math.cos(2 * math.pi * i / n), 0.3 * math.sin(2 * math.pi * i / n)]
+                                      for i in range(n)]]
+
+    return change
+
+
+def _long_fence(n: int) -> Callable[[dict], None]:
+    def change(cell: dict) -> None:
+        cell["fences"].append({"points": [[-2.0 + 4.0 * i / n, -2.5] for i in range(n)], "top": 2.0})
+
+    return change
+
+
+def _many_devices(cell: dict) -> None:
+    curtain = next(d for d in cell["devices"] if d["type"] == "light-curtain")
+    cell["devices"] += [dict(curtain, name=f"c{i}") for i in range(5000)]
+
+
+def _named_start(xy) -> Callable[[dict], None]:
+    def change(cell: dict) -> None:
+        cell["human"]["starts"] = [{"name": "far", "xy": xy, "heading_deg": 0.0, "phase": 0.0}]
+
+    return change
+
+
+# ---- cell files that must be refused (exit 2), by every command that reads a cell ---------------------------
+BAD_CELLS: list[tuple[str, dict, tuple[str, ...]]] = [
+    ("fifo", {"setup": _fifo(CELL)}, ("cell.yaml", "not a regular file")),
+    ("dev-zero", {"setup": _link(CELL, "/dev/zero")}, ("cell.yaml", "not a regular file")),
+    ("directory", {"setup": lambda f: (f / CELL).mkdir()}, ("cell.yaml",)),
+    ("too-big", {"cell_bytes": b"name: x\n" + b"#" * (11 * 2**20) + b"\n"}, ("cell.yaml", "too large")),
+    ("alias-bomb", {"cell_bytes": b"a: &a [x,x,x,x,x,x,x,x,x,x]\n" + b"".join(
+        f"{chr(98 + i)}: &{chr(98 + i)} [*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},"
+        f"*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)}]\n".encode()
+        for i in range(9))}, ("cell.yaml",)),
+    ("deep-nesting", {"cell_bytes": b"name: " + b"[" * 50_000 + b"]" * 50_000 + b"\n"}, ("cell.yaml",)),
+    ("deep-mapping", {"cell_bytes": b"".join(b"  " * i + b"a:\n" for i in range(3000))}, ("cell.yaml",)),
+    ("binary", {"cell_bytes": bytes(range(256)) * 64}, ("cell.yaml",)),
+    ("polygon-20000", {"cell": _big_polygon(20_000)}, ("table.polygons",)),
+    ("fence-20000", {"cell": _long_fence(20_000)}, ("fences",)),
+    ("devices-5000", {"cell": _many_devices}, ("devices",)),
+    ("upper-arm-5m", {"cell": _set("human.anthropometry.upper_arm", 5.0)}, ("upper_arm",)),
+    ("dwell-1e6", {"cell": _set("robot.task.dwell", 1e6)}, ("dwell",)),
+    ("waypoint-1e6-deg", {"cell": _set("robot.task.waypoints_deg[0][0]", 1e6)}, ("waypoints_deg",)),
+    ("speed-scale-tiny", {"cell": _set("robot.task.speed_scale", 1e-12)}, ("speed_scale",)),
+    ("floor-huge", {"cell": _set("floor.xmax", 1e9)}, ("floor.xmax",)),
+    ("phase-huge", {"cell": _set("robot.task.phase", 1e12)}, ("phase",)),
+    ("bool-as-number", {"cell": _set("robot.stopping_time", True)}, ("stopping_time",)),
+    ("text-as-number", {"cell": _set("robot.stopping_time", "0.15")}, ("stopping_time",)),
+    ("nan", {"cell": _set("devices[0].response_time", float("nan"))}, ("response_time",)),
+    ("infinity", {"cell": _set("table.height", float("inf"))}, ("table.height",)),
+    ("negative-time", {"cell": _set("devices[1].response_time", -0.05)}, ("response_time",)),
+    ("huge-integer", {"cell": _set("floor.ymax", 10**400)}, ("floor.ymax",)),
+    ("start-far-away", {"cell": _set("human.start.xy", [100.0, 100.0])}, ("human.start",)),
+    ("named-start-far-away", {"cell": _named_start([100.0, 100.0])}, ("human.starts",)),
+    ("named-start-in-table", {"cell": _named_start([0.0, 0.0])}, ("human.starts",)),
+    ("name-with-nul", {"cell": _set("name", "a\x00b")}, ("name",)),
+    ("name-with-escape", {"cell": _set("name", "\x1b[2J\x1b[31mred")}, ("name",)),
+    ("name-bidi-override", {"cell": _set("name", "abc\u202edcba")}, ("name",)),
+    ("device-name-newline", {"cell": _set("devices[0].name", "a\nb")}, ("devices",)),
+    ("name-too-long", {"cell": _set("name", "n" * 10_000)}, ("name",)),
+    ("unknown-field", {"cell": _set("evil", 1)}, ("evil",)),
+    ("unknown-device", {"cell": _set("devices[0].type", "laser-cannon")}, ("devices",)),
+    ("urdf-etc-passwd", {"cell": _set("robot.urdf", "/etc/passwd")}, ("robot.urdf",)),
+    ("urdf-fifo", {"cell": _set("robot.urdf", "pipe.urdf"), "setup": _fifo("in/pipe.urdf")}, ("robot.urdf",)),
+    ("python-tag", {"cell_bytes": b"!!python/object/apply:os.system ['touch pwned']\n"}, ("cell.yaml",)),
+    ("list-at-top", {"cell_bytes": b"- a\n- b\n"}, ("cell.yaml",)),
+]
+
+
+def _cell_cases() -> list[Case]:
+    out = []
+    for name, spec, says in BAD_CELLS:
+        for command, argv in CELL_COMMANDS.items():
+            out.append(Case(f"cell-{name}-{command}", argv, 2, says, group=f"cell-{name}", **spec))
+    return out
+
+
+# ---- result files: malformed ones are refused (2), forged ones do not replay (1) ----------------------------
+BAD_RESULTS: list[tuple[str, dict, tuple[str, ...]]] = [
+    ("not-json", {"result_bytes": b"{"}, ("result.json", "invalid JSON")),
+    ("deep-json", {"result_bytes": b"[" * 100_000 + b"]" * 100_000}, ("result.json",)),
+    ("top-level-list", {"result_bytes": b"[]"}, ("result.json",)),
+    ("hazard-is-text", {"result": _set("hazard", "boom")}, ("hazard",)),
+    ("cell-is-list", {"result": _set("cell", [1, 2])}, ("cell",)),
+    ("trace-missing", {"result": _delete("hazard.trace")}, ("hazard.trace",)),
+    ("v_R-text", {"result": _set("hazard.v_R", "fast")}, ("hazard.v_R",)),
+    ("seed-negative", {"result": _set("seed", -1)}, ("seed",)),
+    ("seed-bool", {"result": _set("seed", True)}, ("seed",)),
+    ("budget-huge", {"result": _set("budget", 10**12)}, ("budget",)),
+    ("format-2", {"result": _set("format", 2)}, ("format",)),
+    ("unknown-field", {"result": _set("evil", 1)}, ("evil",)),
+    ("actions-100k", {"result": _set("hazard.actions", ["walk+upright"] * 100_000)}, ("hazard.actions",)),
+    ("searcher-long", {"result": _set("searcher", "s" * 100_000)}, ("searcher",)),
+    ("sha-not-hex", {"result": _set("cell.sha256", "z" * 64)}, ("cell.sha256",)),
+    ("result-fifo", {"setup": _fifo(RESULT)}, ("result.json", "not a regular file")),
+    ("result-dev-zero", {"setup": _link(RESULT, "/dev/zero")}, ("result.json", "not a regular file")),
+    ("result-too-big", {"result_bytes": b" " * (11 * 2**20) + b"{}"}, ("result.json", "too large")),
+    ("cell-source-fifo", {"result": _set("cell.source", "{folder}/in/pipe.yaml"), "setup": _fifo("in/pipe.yaml")},
+     ("pipe.yaml", "not a regular file")),
+    ("cell-source-dev-zero", {"result": _set("cell.source", "/dev/zero")}, ("/dev/zero",)),
+    ("cell-source-missing", {"result": _set("cell.source", "{folder}/in/nothing.yaml")}, ("nothing.yaml",)),
+    ("cell-source-etc-passwd", {"result": _set("cell.source", "/etc/passwd")}, ("/etc/passwd",)),
+    ("action-unknown", {"result": _set("hazard.actions", ["walk+upright", "fly+upright"])}, ("fly+upright",)),
+]
+
+FORGED: list[tuple[str, Callable[[dict], None], str]] = [
+    ("time", _set("hazard.time_s", 0.123), "hazard.time_s"),
+    ("step", _set("hazard.step", 2), "hazard.step"),
+    ("link", _set("hazard.robot_link", "base_link"), "hazard.robot_link"),
+    ("part", _set("hazard.body_part", "head"), "hazard.body_part"),
+    ("trace-row", _set("hazard.trace[1].x", 9.0), "hazard.trace[1].x"),
+    ("episode", _set("hazard.episode", 39), "hazard.episode"),
+    ("seed", _set("seed", 11), "seed 11"),
+    ("found", _set("found", False), "found"),
+    ("risks", _set("risk_per_episode[0]", 1e-3), "risk_per_episode[0]"),
+    ("cell-hash", _set("cell.sha256", "0" * 64), "cell.sha256"),
+    ("searcher-unknown", _set("searcher", "<script>alert(1)</script>"), "searcher"),
+]
+
+
+def _result_cases() -> list[Case]:
+    out = []
+    for name, spec, says in BAD_RESULTS:
+        for command in ("replay", "report"):
+            out.append(Case(f"result-{name}-{command}", (command, RESULT), 2, says, group=f"result-{name}",
+                            **spec))
+    for name, change, says in FORGED:
+        out.append(Case(f"forged-{name}-replay", ("replay", RESULT), 1, (says,), result=change))
+    return out
+
+
+# ---- strange but valid names: the commands work, and the text is escaped where it lands ---------------------
+SCRIPT = "<script>alert(1)</script>"
+FORMULA = '=HYPERLINK("http://example.invalid","x")'
+
+
+def _no_raw(*words: str, files: tuple[str, ...] = ()) -> Callable[[Path, str, str], None]:
+    def check(folder: Path, out: str, err: str) -> None:
+        assert "\x1b" not in out + err
+        for rel in files:
+            text = (folder / rel).read_text(encoding="utf-8")
+            for w in words:
+                assert w not in text, f"{w!r} unescaped in {rel}"
+
+    return check
+
+
+def _csv_neutral(folder: Path, out: str, err: str) -> None:
+    lines = (folder / "out" / "table.csv").read_text(encoding="utf-8").splitlines()[1:]
+    assert lines and all(not line.startswith(("=", "+", "-", "@", '"=')) for line in lines), lines
+
+
+def _md_cell_escaped(folder: Path, out: str, err: str) -> None:
+    text = (folder / "out" / "table.md").read_text(encoding="utf-8")
+    assert "a\\|b" in text and "<b>" not in text
+
+
+def _slug_only(folder: Path, out: str, err: str) -> None:
+    pngs = sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*.png"))
+    assert pngs == ["x.png"], pngs
+
+
+CAMPAIGN = CELL_COMMANDS["campaign"]
+NAMED: list[Case] = [
+    Case("name-script-search-report", ("search", CELL, "--budget", "2", "--searcher", "random", "--out", "out"), 0,
+         cell=_set("name", SCRIPT), check=_no_raw(SCRIPT, files=("out/report.html",))),
+    Case("name-script-campaign", CAMPAIGN, 0, cell=_set("name", SCRIPT),
+         check=_no_raw(SCRIPT, files=("out/report.html", "out/table.md"))),
+    Case("device-name-script-report", ("search", CELL, "--budget", "2", "--searcher", "random", "--out", "out"), 0,
+         cell=_set("devices[0].name", SCRIPT), check=_no_raw(SCRIPT, files=("out/report.html",))),
+    Case("name-formula-campaign", CAMPAIGN, 0, cell=_set("name", FORMULA), check=_csv_neutral),
+    Case("name-pipe-campaign", CAMPAIGN, 0, cell=_set("name", "a|b<b>"), check=_md_cell_escaped),
+    Case("name-dollar-show", ("show", CELL, "--out", "out/cell.png"), 0, cell=_set("name", "cost $5 $")),
+    Case("device-name-dollar-show", ("show", CELL, "--out", "out/cell.png"), 0,
+         cell=_set("devices[0].name", "$\\frac{1}{0}$")),
+    Case("name-traversal-show", ("show", CELL), 0, cell=_set("name", "../../x"), creates=("x.png",),
+         check=_slug_only),
+    Case("name-absolute-show", ("show", CELL), 0, cell=_set("name", "/tmp/x"), creates=("tmp-x.png",)),
+    Case("description-escape-check", ("check", CELL), 0, cell=_set("description", "safe\x1b]0;owned\x07 cell"),
+         check=_no_raw()),
+    Case("report-symlink-planted", ("report", RESULT), 0, result=lambda d: None,
+         setup=_link("out/report.html", "../in/victim.txt"),
+         check=lambda folder, out, err: (
+             (folder / "in" / "victim.txt").read_text() == "keep me\n" or pytest.fail("victim overwritten"),
+             (folder / "out" / "report.html").is_symlink() and pytest.fail("report.html still a link"))),
+]
+
+# ---- options ------------------------------------------------------------------------------------------------
+OPTIONS: list[Case] = [
+    Case("search-budget-huge", ("search", "baseline", "--budget", str(10**12), "--out", "out"), 2, ("budget",)),
+    Case("search-seed-negative", ("search", "baseline", "--seed", "-1", "--out", "out"), 2, ("seed",)),
+    Case("search-top-k-huge", ("search", "baseline", "--top-k", str(10**9), "--out", "out"), 2, ("top_k",)),
+    Case("search-candidates-huge", ("search", "s3-fence-gap", "-s", "plan", "--set", "candidates=1000000000",
+                                    "--out", "out"), 2, ("candidates",)),
+    Case("search-pool-inf", ("search", "baseline", "-s", "evolve", "--set", "pool=1e999", "--out", "out"), 2,
+         ("pool",)),
+    Case("search-ec-nan", ("search", "baseline", "--set", "ec=NaN", "--out", "out"), 2, ("ec",)),
+    Case("search-unknown-searcher", ("search", "baseline", "-s", "../../evil", "--out", "out"), 2,
+         ("unknown searcher",)),
+    Case("search-unknown-criterion", ("search", "baseline", "--criterion", "<x>", "--out", "out"), 2,
+         ("criterion",)),
+    Case("search-out-is-a-file", ("search", "baseline", "--out", "in/file"), 2, ("--out",),
+         setup=lambda f: (f / "in" / "file").write_text("x"), group="search-out-is-a-file"),
+    Case("search-distinct-without-budget", ("search", "baseline", "--distinct", "--out", "out"), 2,
+         ("--distinct",)),
+    Case("campaign-seeds-huge", ("campaign", "--seeds", str(10**9), "--out", "out"), 2, ("--seeds",)),
+    Case("campaign-workers-huge", ("campaign", "--workers", str(10**6), "--out", "out"), 2, ("--workers",)),
+    Case("campaign-unknown-searcher", ("campaign", "--searchers", "nope", "--out", "out"), 2, ("nope",)),
+    Case("campaign-unknown-cell", ("campaign", "--cells", "no-such-cell", "--out", "out"), 2, ("no-such-cell",)),
+    Case("simulate-unknown-action", ("simulate", "baseline", "--actions", "walk+fly"), 2, ("walk+fly",)),
+    Case("simulate-100k-actions", ("simulate", "baseline", "--actions", ",".join(["walk+upright"] * 5_000)), 2,
+         ("actions",)),
+    Case("replay-hazard-index", ("replay", RESULT, "--hazard", "5"), 2, ("--hazard 5",), result=lambda d: None,
+         group="replay-hazard-index"),
+    Case("show-not-png", ("show", "baseline", "--out", "out/x.txt"), 2, (".png",)),
+    Case("check-unknown-cell", ("check", "../../etc/passwd"), 2, ("passwd",)),
+]
+
+CASES = _cell_cases() + _result_cases() + NAMED + OPTIONS
+
+
+def _snapshot(folder: Path) -> dict[str, bytes | str]:
+    out: dict[str, bytes | str] = {}
+    for p in sorted(folder.rglob("*")):
+        rel = p.relative_to(folder).as_posix()
+        if p.is_symlink():
+            out[rel] = "link:" + os.readlink(p)
+        elif p.is_file():
+            out[rel] = p.read_bytes() if p.stat().st_size < 2**20 else f"size:{p.stat().st_size}"
+    return out
+
+
+def _prepare(case: Case, folder: Path, baseline: dict, result: dict) -> None:
+    (folder / "in").mkdir(parents=True, exist_ok=True)
+    (folder / "in" / "victim.txt").write_text("keep me\n")
+    if case.setup is not None:
+        case.setup(folder)
+    if case.cell is not None or case.cell_bytes is not None:
+        data = case.cell_bytes
+        if data is None:
+            cell = copy.deepcopy(baseline)
+            case.cell(cell)
+            data = yaml.safe_dump(cell, sort_keys=False, allow_unicode=True, width=10**9).encode("utf-8")
+        (folder / CELL).write_bytes(data)
+    if case.result is not None or case.result_bytes is not None:
+        data = case.result_bytes
+        if data is None:
+            doc = copy.deepcopy(result)
+            case.result(doc)
+            data = json.dumps(doc).replace("{folder}", str(folder)).encode("utf-8")
+        (folder / "out").mkdir(exist_ok=True)
+        (folder / RESULT).write_bytes(data)
+
+
+@dataclass
+class Ran:
+    code: int | None
+    out: str
+    err: str
+    before: dict = field(default_factory=dict)
+    after: dict = field(default_factory=dict)
+
+
+def _group(case: Case) -> str:
+    if case.group:
+        return case.group
+    return "options" if case in OPTIONS else case.id
+
+
+def _run_group(cases: list[Case], folder: Path, commands: Path, env: dict[str, str]) -> list[Ran]:
+    before = _snapshot(folder)
+    commands.write_text(json.dumps([list(c.argv) for c in cases]))
+    report = commands.with_suffix(".out.json")
+    try:
+        p = subprocess.run([sys.executable, "-c", CHILD, str(commands), str(report)], cwd=folder, env=env,
+                           capture_output=True, timeout=TIME_LIMIT, stdin=subprocess.DEVNULL)
+        done = json.loads(report.read_text()) if p.returncode == 0 else []
+        ran = [Ran(d["code"], d["out"], d["err"]) for d in done]
+        if len(ran) != len(cases):
+            problem = f"the process ended with {p.returncode}: {p.stderr.decode('utf-8', 'replace')[-1500:]}"
+            ran = [Ran(-1, "", problem) for _ in cases]
+    except subprocess.TimeoutExpired:
+        ran = [Ran(None, "", f"timed out after {TIME_LIMIT} s") for _ in cases]
+    after = _snapshot(folder)
+    for r in ran:
+        r.before, r.after = before, after
+    return ran
+
+
+@pytest.fixture(scope="module")
+def ran(tmp_path_factory) -> dict[str, tuple[Path, Ran]]:
+    root = tmp_path_factory.mktemp("hostile")
+    text = resources.files("cellstress.cell").joinpath("builtin", "baseline.yaml").read_text(encoding="utf-8")
+    baseline = yaml.safe_load(text)
+    made = root / "reference"
+    assert main(["search", "s3-fence-gap", "--searcher", "plan", "--budget", "40", "--out", str(made),
+                 "--no-report"]) == 0
+    result = json.loads((made / "result.json").read_text())
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("COLUMNS", "FORCE_COLOR"))}
+    env.update(HOME=str(root / "home"), CELLSTRESS_CACHE=os.environ.get("CELLSTRESS_CACHE",
+                                                                      str(Path.home() / ".cache")))
+    groups: dict[str, list[Case]] = {}
+    for case in CASES:
+        groups.setdefault(_group(case), []).append(case)
+    (root / "commands").mkdir()
+    folders = {}
+    for name, cases in groups.items():
+        folders[name] = root / "cases" / name
+        _prepare(cases[0], folders[name], baseline, result)
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        futures = {name: pool.submit(_run_group, cases, folders[name], root / "commands" / f"{name}.json", env)
+                   for name, cases in groups.items()}
+        out = {}
+        for name, cases in groups.items():
+            for case, r in zip(cases, futures[name].result(), strict=True):
+                out[case.id] = (folders[name], r)
+        return out
+
+
+def test_the_corpus_is_large_and_varied() -> None:
+    assert len(CASES) >= 60
+    assert len({c.id for c in CASES}) == len(CASES)
+    commands = {c.argv[0] for c in CASES}
+    assert {"check", "search", "replay", "report", "show", "campaign", "simulate"} <= commands
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c.id for c in CASES])
+def test_hostile_input(case: Case, ran) -> None:
+    folder, r = ran[case.id]
+    assert r.code is not None, f"{case.id}: {r.err}"
+    assert "Traceback" not in r.err and "Traceback" not in r.out, r.err[-2000:]
+    assert r.code == case.code, f"exit {r.code}, expected {case.code}\nstdout: {r.out[-1500:]}\nstderr: {r.err[-1500:]}"
+    if case.code == 2:
+        lines = r.err.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("error: "), r.err[-2000:]
+        assert len(lines[0]) < 1000, lines[0][:300]
+        for w in case.says:
+            assert w in lines[0], f"{w!r} not in {lines[0]!r}"
+    elif case.code == 1:
+        mismatches = [line for line in r.out.splitlines() if line.startswith("MISMATCH: ")]
+        assert mismatches and any(w in mismatches[0] for w in case.says), r.out[-1500:]
+        assert "REPRODUCED" not in r.out
+    assert "\x1b" not in r.out + r.err
+    # nothing created or changed outside out/ (and the files a case may create)
+    outside = {k: v for k, v in r.after.items() if not k.startswith("out/") and k not in case.creates}
+    assert outside == {k: v for k, v in r.before.items() if not k.startswith("out/")}
+    if case.check is not None:
+        case.check(folder, r.out, r.err)
