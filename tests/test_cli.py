@@ -117,7 +117,16 @@ def test_check_baseline_summary(capsys, baseline) -> None:
     x, y = baseline["human"]["start"]["xy"]
     assert f"start ({x:g}, {y:g}) heading {baseline['human']['start']['heading_deg']:g} deg" in out
     assert "contact-while-moving" in out
-    assert out.strip().splitlines()[-1] == "valid"
+    assert code == 0
+    assert out.strip().splitlines()[-1] == "PASS: the cell file is valid and the static check passes"
+
+
+@pytest.mark.parametrize("cell", ["s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap"])
+def test_check_exits_1_on_a_failed_static_check(capsys, cell) -> None:
+    """A CI gate: a flawed design fails the static check with exit code 1, and the last line says what failed."""
+    code, out, err = _run(["check", cell], capsys)
+    assert code == 1, err
+    assert out.strip().splitlines()[-1].startswith("FAIL: the cell file is valid, the static check fails (")
 
 
 def test_check_file_path(capsys, baseline, tmp_path) -> None:
@@ -143,10 +152,10 @@ def test_check_iso13855_user_error_is_one_line(capsys, monkeypatch) -> None:
     from cellstress.analysis import iso13855
     from cellstress.core.errors import CellError
 
-    def static_check(cell):
+    def check_cell(cell):
         raise CellError(cell.source, "devices[0]", "too close")
 
-    monkeypatch.setattr(iso13855, "static_check", static_check)
+    monkeypatch.setattr(iso13855, "check_cell", check_cell)
     code, _, err = _run(["check", "baseline"], capsys)
     assert code == 2 and err == "error: baseline: devices[0]: too close\n"
 
@@ -182,7 +191,7 @@ def test_simulate_unsafe_table(capsys, unguarded) -> None:
 
     path, actions = unguarded
     code, out, err = _run(["simulate", str(path), "--actions", ",".join(actions)], capsys)
-    assert code == 0, err  # unsafe is a finding, not an error
+    assert code == 1, err  # unsafe is a finding (1), not a user error (2)
     trace = Simulator(load_cell(path)).run(actions)
     hit = trace.record(trace.unsafe_row)
     last = out.strip().splitlines()[-1]
@@ -222,7 +231,7 @@ def test_simulate_json_safe(capsys) -> None:
 def test_simulate_json_unsafe(capsys, unguarded) -> None:
     path, actions = unguarded
     code, out, err = _run(["simulate", str(path), "-a", ",".join(actions), "--json"], capsys)
-    assert code == 0, err
+    assert code == 1, err
     doc = json.loads(out)
     assert doc["cell"] == "unguarded" and doc["unsafe"] is True
     hazard = doc["hazard"]

@@ -12,10 +12,13 @@ from cellstress.cli.common import CELL_HELP, first_sentence, num, say, user_erro
 def check(
     cell: Annotated[str, typer.Argument(help=CELL_HELP)],
 ) -> None:
-    """Validate a cell file and print a summary of it."""
+    """Validate a cell file, print a summary of it and run the static ISO 13855 / ISO 13857 check.
+
+    Exit code 0 if the static check passes, 1 if it fails (a gate for a design in CI), 2 for a file that is not
+    a valid cell."""
     import numpy as np
 
-    from cellstress.analysis.iso13855 import static_check
+    from cellstress.analysis.iso13855 import check_cell
     from cellstress.cell.load import BUILTIN_CELLS, load_cell
     from cellstress.robot.capsules import declared_capsule, fitted_capsules
     from cellstress.robot.model import load_robot, resolve_urdf
@@ -38,7 +41,7 @@ def check(
             caps.append(declared_capsule(robot, f"{k.link}#extra{i}", k.link, k.p0, k.p1, k.radius))
         task = spec.robot.task
         traj = build_trajectory(task.waypoints_deg, task.dwell, task.speed_scale, robot.velocity_limits)
-        static = static_check(c)
+        static = check_cell(c)
 
     out = say
     origin = "built-in" if cell in BUILTIN_CELLS else "file"
@@ -75,6 +78,10 @@ def check(
     out(f"simulation  dt {num(sim.dt)} s, {sim.steps_per_action} steps per action, "
         f"{sim.actions_per_episode} actions per episode")
     out("ISO 13855 static check:")
-    for line in static:
+    for line in static.lines():
         out(f"  {line}")
-    out("valid")
+    if static.ok:
+        out("PASS: the cell file is valid and the static check passes")
+    else:
+        out(f"FAIL: the cell file is valid, the static check fails ({', '.join(static.failures())})")
+        raise typer.Exit(1)

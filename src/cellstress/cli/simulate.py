@@ -18,7 +18,9 @@ def simulate(
         = False,
     criterion: Annotated[str | None, typer.Option("--criterion", help=criterion_help("the cell file's"))] = None,
 ) -> None:
-    """Play a sequence of worker actions in a cell and report whether it ends in an unsafe contact."""
+    """Play a sequence of worker actions in a cell and report whether it ends in an unsafe contact.
+
+    Exit code 0 if the episode stays safe, 1 if it ends unsafe, 2 for a bad cell or action."""
     from cellstress.cell.load import load_cell, with_criterion
     from cellstress.core.io import json_ready
     from cellstress.human.actions import ACTION_NAMES, parse_actions
@@ -47,6 +49,8 @@ def simulate(
         doc = {"cell": c.name, "actions": [ACTION_NAMES[i] for i in indices], "steps": records,
                "unsafe": hazard is not None, "hazard": hazard}
         say(json.dumps(json_ready(doc), indent=1, allow_nan=False))
+        if hazard is not None:
+            raise typer.Exit(1)
         return
     say(HEADER)
     for r in records:
@@ -58,3 +62,4 @@ def simulate(
                    f"{hazard['robot_link']} / {hazard['body_part']}")
         if verdict is not None:
             say(f"{sim.criterion.type}  {verdict.reason}")
+        raise typer.Exit(1)
