@@ -31,7 +31,8 @@ def test_docs_show_commands():
 
 @pytest.mark.parametrize(("doc", "line"), COMMANDS)
 def test_doc_command_runs(doc, line, tmp_path):
-    out = subprocess.run([sys.executable, "-m", "cellstress", *shlex.split(line, comments=True)[1:]], capture_output=True,
+    out = subprocess.run([sys.executable, "-m", "cellstress", *shlex.split(line, comments=True)[1:]],
+                         capture_output=True,
                          text=True, cwd=tmp_path, timeout=600)
     assert out.returncode == expected_code(line), (doc, line, out.stderr)
     assert out.stdout.strip()

@@ -48,7 +48,8 @@ def test_cli_examples(tmp_path):
              for ln in body.strip().splitlines() if ln.startswith("cellstress ")]
     assert len(lines) >= 7
     for line in lines:
-        out = subprocess.run([sys.executable, "-m", "cellstress", *shlex.split(line, comments=True)[1:]], capture_output=True,
+        out = subprocess.run([sys.executable, "-m", "cellstress", *shlex.split(line, comments=True)[1:]],
+                         capture_output=True,
                              text=True, cwd=tmp_path, timeout=600)
         assert out.returncode == expected_code(line), (line, out.stderr)
         assert out.stdout.strip(), line
