@@ -284,6 +284,15 @@ def test_help_exits_0(capsys) -> None:
     assert "simulate" in out and "check" in out and "cells" in out
 
 
+@pytest.mark.parametrize("command", ["cells", "check", "simulate", "search", "replay", "campaign", "report", "show"])
+def test_command_help_names_values_plainly(capsys, command) -> None:
+    """``--out OUT``, not ``--out <str>``; a flag such as ``--help`` or ``--json`` shows no value."""
+    code, out, _ = _run([command, "--help"], capsys)
+    assert code == 0 and "Usage: cellstress " + command in out
+    assert "<str>" not in out and "<bool>" not in out and "<int>" not in out
+    assert re.search(r"^\s+--help\s+Show this message", out, re.M)
+
+
 def test_cli_runner_user_error_is_one_line() -> None:
     """Through typer's own runner (no main()): a CellstressError still gives exit 2 and one stderr line."""
     result = CliRunner().invoke(app, ["check", "/no/such/cell.yaml"])

@@ -24,15 +24,32 @@ app = typer.Typer(
     add_completion=False,
     no_args_is_help=True,
     pretty_exceptions_enable=False,
+    rich_markup_mode=None,
     help="Find hidden human-robot hazards in industrial robot cells.",
 )
 for command in (cells, check, simulate, search, replay, campaign, report, show):
     app.command()(command)
 
 
+def _name_the_values(command) -> None:
+    """Help shows ``--out OUT`` and ``CELL``, as argparse would, instead of typer's ``<str>`` on every line; a
+    flag shows no value at all (typer would print ``<bool>``)."""
+    for sub in getattr(command, "commands", {}).values():
+        for param in sub.params:
+            if param.param_type_name == "argument":  # its help line would read "CELL <str>"
+                param.display_type_rich = lambda ctx: None
+            if param.metavar is not None:
+                continue
+            if getattr(param, "is_flag", False):
+                param.metavar = ""
+            else:
+                param.metavar = param.name.upper()
+
+
 def main(argv: list[str] | None = None) -> int:
     """The ``cellstress`` console script. Returns the exit code (0 ok, 1 a finding, 2 user error)."""
     command = typer.main.get_command(app)
+    _name_the_values(command)
     try:
         rv = command.main(args=argv, prog_name="cellstress", standalone_mode=False)
     except typer.TyperException as exc:  # click's usage errors and bad parameters
