@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import pytest
 
@@ -23,12 +24,14 @@ def test_search_summary_and_replay(tmp_path, capsys) -> None:
     h = doc["hazard"]
     lines = out.splitlines()
     assert lines[0].startswith("cell      s3-fence-gap  searcher mcts-commit (n auto, ec 0.5, k 1, alpha 0.85)")
-    assert lines[1].startswith(f"FOUND at episode {h['episode']} of 200 ")
-    assert "episodes/s" in lines[1]
-    assert lines[2] == "actions   " + ", ".join(h["actions"])
-    assert lines[3].startswith(f"contact   t={h['time_s']:g} s (step {h['step']}): {h['robot_link']} / "
+    assert lines[1].startswith("criterion contact-while-moving: unsafe when the worker touches the robot")
+    assert lines[2].startswith(f"FOUND at episode {h['episode']} of 200 ")
+    assert "episodes/s" in lines[2]
+    assert lines[3] == "actions   " + ", ".join(h["actions"])
+    assert lines[4].startswith(f"contact   t={h['time_s']:g} s (step {h['step']}): {h['robot_link']} / "
                                f"{h['body_part']} at (")
     assert lines[-1] == f"wrote     {tmp_path / 'result.json'}"
+    assert doc["cell"]["criterion"] == "contact-while-moving"  # the file names its criterion too
     code, out, err = _run(["replay", str(tmp_path / "result.json")], capsys)
     assert code == 0, err
     rows = out.splitlines()
@@ -213,3 +216,31 @@ def test_bad_set_options(tmp_path, capsys, args, says) -> None:
     code, _, err = _run(["search", "s1-scanner-width", *args, "--out", str(tmp_path / "x")], capsys)
     assert code == 2 and err.startswith("error: ") and err.count("\n") == 1 and says in err, err
     assert not (tmp_path / "x" / "result.json").exists()
+
+
+def test_no_hazard_says_what_was_searched_and_that_it_is_no_proof(tmp_path, capsys) -> None:
+    code, out, err = _run(["search", "baseline", "--searcher", "random", "--budget", "30", "--out", str(tmp_path),
+                           "--no-report"], capsys)
+    assert code == 0, err
+    lines = out.splitlines()
+    assert lines[1].startswith("criterion contact-while-moving: ")
+    assert lines[2].startswith("no hazard found in 30 episodes")
+    doc = json.loads((tmp_path / "result.json").read_text())
+    assert 1 <= doc["distinct_sequences"] <= 30
+    assert lines[3] == (f"searched  30 episodes of up to 8 actions ({doc['distinct_sequences']} different action "
+                        "sequences), from the start point (0.7, 3.35) with the robot 1.4 s into its cycle (cycle "
+                        "5.71 s; other arrival moments were not searched)")
+    assert lines[4].startswith("note      A search is not a proof")
+
+
+def test_iso15066_names_force_and_limit(tmp_path, capsys) -> None:
+    """Under a criterion that judges contacts, the strongest contact's force and limit are printed even when
+    no contact is unsafe (S3's witness reach is a hand contact far below the limit: docs/criteria.md)."""
+    code, out, err = _run(["search", "s3-fence-gap", "--criterion", "iso15066", "--searcher", "plan", "--budget",
+                           "100", "--out", str(tmp_path), "--no-report"], capsys)
+    assert code == 0, err
+    assert "criterion iso15066: unsafe when a contact's estimated peak force exceeds" in out
+    line = next(ln for ln in out.splitlines() if ln.startswith("strongest contact"))
+    assert re.search(r": \d+ N against a \d+ N limit \(\w+", line), line
+    doc = json.loads((tmp_path / "result.json").read_text())
+    assert doc["cell"]["criterion"] == "iso15066"

@@ -71,6 +71,7 @@ def search(
 
     from cellstress.cell.load import load_cell, with_criterion
     from cellstress.cli.report import after_search
+    from cellstress.report.scope import NOT_A_PROOF, judged_by, search_scope, strongest_contact
     from cellstress.searchers import make_searcher, parse_options
     from cellstress.searchers import search as run
     from cellstress.searchers.common import check_common
@@ -132,11 +133,17 @@ def search(
     echo = say
     echo(f"cell      {result.cell.name}  searcher {result.searcher} ({_params_text(result.params)})  "
          f"seed {seed}  budget {budget}")
+    echo(f"criterion {judged_by(sim.criterion)}")
     best = max(result.risk_per_episode, default=0.0)
     h = result.hazard
     if h is None:
-        echo(f"no hazard in {result.episodes} episodes (best risk {best:.3f}; {elapsed:.2f} s, "
+        echo(f"no hazard found in {result.episodes} episodes (best risk {best:.3f}; {elapsed:.2f} s, "
              f"{rate:.0f} episodes/s)")
+        echo(f"searched  {search_scope(result, sim.cell.spec, sim.layout.trajectory.cycle)}")
+        strongest = strongest_contact(sim, result.top[0].actions) if result.top else None
+        if strongest is not None:
+            echo(f"strongest contact of the riskiest episode ({result.top[0].episode}): {strongest}")
+        echo(f"note      {NOT_A_PROOF}")
     else:
         extra_text = f", {len(result.hazards)} hazardous episodes in all" if until == "budget" else ""
         echo(f"FOUND at episode {h.episode} of {budget}{extra_text} ({result.episodes} episodes in "
@@ -145,6 +152,9 @@ def search(
         x, y, z = h.point
         echo(f"contact   t={num(h.time_s)} s (step {h.step}): {h.robot_link} / {h.body_part} at "
              f"({x:.3f}, {y:.3f}, {z:.3f}) m, robot moving at v_R {h.v_R:.3f} m/s")
+        if h.verdict is not None:  # a criterion that judges contacts: its account of this one
+            name, numbers = h.verdict
+            echo(f"{name:<9} {numbers.get('reason')}")
     for i, d in enumerate(result.distinct or ()):
         cls = d.klass
         x0, y0, x1, y1 = cls.approach_cell

@@ -224,6 +224,10 @@ class Criterion(Protocol):
     distance_tolerance: float
     speed_tolerance: float
 
+    def describe(self) -> str:
+        """One sentence for people: what this criterion calls unsafe (reports and the command line name it)."""
+        ...
+
     def kernel_test(self) -> KernelTest | None: ...
 
     def judge(self, contact: Contact) -> Verdict: ...

@@ -103,6 +103,11 @@ class Iso15066(CriterionRecord):
     type: Literal["iso15066"] = "iso15066"
     payload: Annotated[float, Field(ge=0.0, le=1000.0)] = 2.0
 
+    def describe(self) -> str:
+        return ("unsafe when a contact's estimated peak force exceeds the ISO/TS 15066 transient limit of the body "
+                "region touched, or the head is touched while the robot moves (robot payload "
+                f"{self.payload:g} kg; docs/criteria.md)")
+
     def rule(self, region: str, force: float, moving: bool) -> tuple[bool, str | None]:
         """(unsafe, reason) of a contact on ``region`` with the predicted force [N]."""
         if moving and region in HEAD_REGIONS:

@@ -4,6 +4,8 @@ contact seen from above and from the side, and the search's risk per episode.
 
 from __future__ import annotations
 
+import textwrap
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -240,26 +242,36 @@ def contact_figure(view: EpisodeView, size: D.FigureSize = StillOptions().contac
     return fig
 
 
+RISK_NOTE = ("The risk is the search's guide, not the verdict: the criterion decides what is unsafe. With the "
+             "paper's c_S it is exp(v_R) / (d_HR² + 1), so a fast robot near the worker scores high with or without "
+             "a hazard, and a hazardous contact with a slow robot can score below a near miss.")
+
+
 def risk_figure(risks: list[float], hazard_episode: int | None, size: D.FigureSize = StillOptions().risk,
-                title: str = ""):
-    """Each episode's maximum risk 1/c_S and the best so far, against the episode number."""
+                title: str = "", hazard_episodes: tuple[int, ...] = ()):
+    """Each episode's maximum risk (the searcher's reward signal) and the best so far, against the episode
+    number, with every hazardous episode marked: the figure must not suggest that the highest risk is the
+    hazard (``RISK_NOTE`` is printed under it)."""
     fig = D.new_figure(size)
-    ax = fig.add_axes((0.1, 0.14, 0.86, 0.74))
+    ax = fig.add_axes((0.1, 0.24, 0.86, 0.64))
     r = np.array([np.nan if v is None else v for v in risks], dtype=float)
     n = np.arange(1, len(r) + 1)
-    ax.plot(n, r, ".", color="#7f7f7f", ms=4, label="max risk of the episode")
+    ax.plot(n, r, ".", color="#7f7f7f", ms=4, label="episode's max risk (no hazard)")
     if len(r):
-        ax.step(n, np.fmax.accumulate(np.nan_to_num(r, nan=0.0)), where="post", color="#d62728", lw=1.8,
-                label="best so far")
+        ax.step(n, np.fmax.accumulate(np.nan_to_num(r, nan=0.0)), where="post", color="#1f77b4", lw=1.5,
+                label="highest risk so far (guides the search)")
+    marked = [e for e in sorted(set(hazard_episodes) | ({hazard_episode} if hazard_episode else set()))
+              if 1 <= e <= len(r)]
+    if marked:
+        ax.plot(marked, r[np.array(marked) - 1], "o", ms=6, color=D.CONTACT, mec="black", mew=0.5, ls="none",
+                label=f"hazardous episode ({len(marked)})")
     if hazard_episode is not None:
         ax.axvline(hazard_episode, color="black", ls="--", lw=1.0, label=f"first hazard (episode {hazard_episode})")
-        if 1 <= hazard_episode <= len(r):
-            ax.plot([hazard_episode], [r[hazard_episode - 1]], marker="*", ms=12, color=D.CONTACT, mec="black",
-                    ls="none", label="the hazardous episode's risk")
     ax.set_xlabel("episode")
-    ax.set_ylabel("risk 1/c_S = exp(v_R) / (d_HR² + 1)")
+    ax.set_ylabel("risk (search signal)")
     ax.set_xlim(0.5, max(len(r), 1) + 0.5)
     ax.grid(True, color="#dddddd", lw=0.5)
     ax.legend(fontsize=8, loc="lower right")
     ax.set_title(title or "risk per episode", fontsize=10, loc="left")
+    fig.text(0.02, 0.02, "\n".join(textwrap.wrap(RISK_NOTE, 125)), fontsize=7.5, color="#444444", va="bottom")
     return fig

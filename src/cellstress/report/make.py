@@ -13,6 +13,7 @@ from cellstress.report import html as H
 from cellstress.report.animate import AnimationOptions, animate
 from cellstress.report.episode import EpisodeView, episode_of
 from cellstress.report.hazard import StillOptions, contact_figure, risk_figure, topview_figure
+from cellstress.report.scope import NOT_A_PROOF, judged_by, search_scope, strongest_contact
 from cellstress.report.story import Account, account
 from cellstress.searchers.result import FILE_NAME, SearchResult
 
@@ -86,10 +87,13 @@ def write_report(result: SearchResult | str | Path, out_dir: str | Path | None =
     gif = animate(view, out / NAMES[2], options.animation, zone=zone)
     h = res.hazard
     title = f"{res.searcher}, seed {res.seed}: max risk per episode ({res.episodes} episodes)"
-    risk = D.save_png(risk_figure(res.risk_per_episode, h.episode if h else None, st.risk, title), out / NAMES[3])
+    risk = D.save_png(risk_figure(res.risk_per_episode, h.episode if h else None, st.risk, title,
+                                  tuple(e.episode for e in res.hazards)), out / NAMES[3])
     acc = account(view, res.episodes)
     changed = sim.cell.sha256 != res.cell.sha256
-    page = hazard_page(res, view, acc, top, contact, gif, risk, changed)
+    strongest = None if res.found else strongest_contact(sim, view.actions)
+    page = hazard_page(res, view, acc, top, contact, gif, risk, changed, Judgement(
+        judged_by(sim.criterion), search_scope(res, sim.cell.spec, sim.layout.trajectory.cycle), strongest))
     html = H.write_page(out / NAMES[4], page)
     return ReportFiles(top, contact, gif, risk, html, acc, res.found, changed)
 
@@ -115,21 +119,38 @@ def action_rows(view: EpisodeView) -> tuple[list[list], list[str]]:
     return rows, classes
 
 
+@dataclass(frozen=True)
+class Judgement:
+    """What the page says was judged: the criterion in words, what the search covered, and (no hazard, a
+    criterion that judges contacts) the strongest contact of the episode shown."""
+
+    criterion: str
+    scope: str
+    strongest: str | None = None
+
+
 def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, contact: Path, gif: Path,
-                risk: Path, cell_changed: bool) -> str:
+                risk: Path, cell_changed: bool, judgement: Judgement) -> str:
     cell = res.cell.name
-    body = [f"<h1>cellstress report: {H.escape(cell)}</h1>"]
+    e = H.escape
+    body = [f"<h1>cellstress report: {e(cell)}</h1>"]
     if res.found:
         h = res.hazard
-        e = H.escape
         verdict = (f"<b>Hazard found</b> at episode {h.episode} of {res.budget} ({e(res.searcher)}, seed "
                    f"{res.seed}): {e(str(h.robot_link))} / {e(str(h.body_part))} at t = {h.time_s:.2f} s, "
                    f"v_R = {h.v_R:.2f} m/s.")
+        if h.verdict is not None:
+            name, numbers = h.verdict
+            verdict += f" {e(name)}: {e(str(numbers.get('reason')))}."
+        verdict += f"<br>Judged by {e(judgement.criterion)}."
         body.append(f'<div class="verdict hazard">{verdict}</div>')
     else:
+        strongest = ("" if judgement.strongest is None else
+                     f" Its strongest contact: {e(judgement.strongest)}.")
         body.append(f'<div class="verdict safe"><b>No hazard found</b> in {res.episodes} episodes '
-                    f"({H.escape(res.searcher)}, seed {res.seed}). The riskiest episode kept (episode "
-                    f"{view.episode}) is shown instead.</div>")
+                    f"({e(res.searcher)}, seed {res.seed}), judged by {e(judgement.criterion)}.<br>"
+                    f"Searched: {e(judgement.scope)}.<br>{e(NOT_A_PROOF)}<br>The riskiest episode kept "
+                    f"(episode {view.episode}) is shown instead.{strongest}</div>")
     if cell_changed:
         body.append('<p class="warn">The cell file has changed since the search (sha256 differs): the pictures '
                     "show the episode replayed in the current cell.</p>")
@@ -147,7 +168,8 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
                          "contact view"))
     body.append(H.figure(gif, f"The episode, one frame per {view.dt:g} s simulation step ({len(view.records)} frames, "
                          "shown at a quarter of real time).", "animated replay"))
-    body.append(H.figure(risk, "The search: each episode's maximum risk 1/c_S and the best so far.", "risk plot"))
+    body.append(H.figure(risk, "The search: each episode's maximum risk (the searcher's guide, not the verdict) and the "
+                         "highest so far; hazardous episodes in red.", "risk plot"))
     body.append("<h2>Actions</h2>")
     rows, classes = action_rows(view)
     body.append(H.table(["#", "action", "t [s]", "position at end [m]", "heading [deg]", "forward [deg]",
@@ -160,6 +182,7 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
         ["cell", f"{cell} ({res.cell.source})"],
         ["cell sha256", res.cell.sha256],
         ["searcher", f"{res.searcher} ({params})"],
+        ["criterion", judgement.criterion],
         ["seed", res.seed], ["budget", f"{res.budget} episodes (until {res.until})"],
         ["episodes used", res.episodes], ["hazardous episodes", len(res.hazards)],
         ["episode shown", f"{view.episode} ({'first hazard' if view.kind == 'hazard' else 'riskiest kept'})"],

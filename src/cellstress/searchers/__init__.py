@@ -102,7 +102,8 @@ def run_search(problem, reward, searcher="mcts", budget=DEFAULT_BUDGET, seed=0, 
         s.run(problem, reward, rec, int(seed))
     except Stop:
         pass
-    return Outcome(rec.episodes, tuple(rec.hazards), tuple(rec.top.best()), tuple(rec.risks))
+    return Outcome(rec.episodes, tuple(rec.hazards), tuple(rec.top.best()), tuple(rec.risks),
+                   rec.distinct_sequences)
 
 
 def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int = 0, *, until: str = "first",
@@ -158,8 +159,7 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
     source = c.source if c.directory is None else str(Path(c.source).expanduser().resolve())
     crit = c.spec.criterion.type
     return SearchResult.model_construct(
-        cell=CellRef.model_construct(name=c.name, sha256=c.sha256, source=source,
-                                     criterion=None if crit == DEFAULT_CRITERION else crit),
+        cell=CellRef.model_construct(name=c.name, sha256=c.sha256, source=source, criterion=crit),
         searcher=s.name,
         params=asdict(s),
         seed=int(seed),
@@ -173,6 +173,7 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
         top=tuple(TopEpisode.model_construct(episode=e.index, actions=tuple(names(e.actions)), ret=e.ret,
                                              risk=e.risk, unsafe=e.unsafe) for e in out.top),
         risk_per_episode=tuple(out.risks),
+        distinct_sequences=out.distinct_sequences,
         version=__version__,
         format=FORMAT,
         distinct=None if rec is None else tuple(

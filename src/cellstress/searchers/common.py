@@ -64,6 +64,9 @@ class TopK:
         return [it[3] for it in sorted(self._heap, key=lambda it: it[:2], reverse=True)]
 
 
+MAX_TRACKED = 2_000_000  # distinct sequences counted (a hash each): beyond it, "at least" this many
+
+
 class Stop(Exception):
     """Raised inside a searcher when the search is over (budget used up, or first hazard with until=first)."""
 
@@ -87,6 +90,12 @@ class Recorder:
 
     def __post_init__(self):
         self.top = TopK(self.top_k)
+        self._seen: set[int] = set()  # hashes of the sequences played, for the count of distinct ones
+
+    @property
+    def distinct_sequences(self) -> int:
+        """How many different action sequences the episodes played (exact up to ``MAX_TRACKED``)."""
+        return len(self._seen)
 
     @property
     def left(self) -> int:
@@ -98,6 +107,8 @@ class Recorder:
         self.episodes += 1
         ep = Episode(self.episodes, tuple(int(a) for a in actions), float(ret), float(risk), bool(unsafe))
         self.risks.append(ep.risk)
+        if len(self._seen) < MAX_TRACKED:
+            self._seen.add(hash(ep.actions))
         self.best_risk = max(self.best_risk, ep.risk)
         self.top.add(ep)
         if unsafe:
@@ -117,6 +128,7 @@ class Outcome:
     hazards: tuple[Episode, ...]
     top: tuple[Episode, ...]
     risks: tuple[float, ...]
+    distinct_sequences: int = 0  # different action sequences played (at most MAX_TRACKED counted)
 
     @property
     def found(self) -> bool:

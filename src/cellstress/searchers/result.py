@@ -40,7 +40,8 @@ VERDICT = TypeAdapter(dict[Name, bool | int | float | Annotated[str, Field(max_l
 
 class CellRef(Record):
     """The cell searched: its name, the sha256 of its file's text, where it came from (a built-in name or an
-    absolute path), and the criterion it was judged by when that is not its own."""
+    absolute path), and the criterion it was judged by (absent from early files: the default,
+    contact-while-moving)."""
 
     name: Name
     sha256: Annotated[str, Field(pattern=r"^[0-9a-f]{64}$")]
@@ -136,6 +137,9 @@ class SearchResult(Record):
     hazards: Annotated[tuple[EpisodeRef, ...], Field(max_length=MAX_LISTED)]  # every hazardous episode
     top: Annotated[tuple[TopEpisode, ...], Field(max_length=MAX_LISTED)]  # the top-k episodes by return
     risk_per_episode: Annotated[tuple[float | None, ...], Field(max_length=MAX_EPISODES)]  # max 1/c_S each
+    # how many different action sequences the episodes played (counted up to searchers.common.MAX_TRACKED;
+    # absent from files written before it was recorded)
+    distinct_sequences: Annotated[int, Field(ge=0, le=MAX_EPISODES)] | None = None
     version: Name
     format: Literal[1] = FORMAT
     # distinct mode only (absent from the file otherwise): the first hazard of each class, in the order found
@@ -143,8 +147,9 @@ class SearchResult(Record):
 
     def to_dict(self) -> dict[str, Any]:
         doc = self.model_dump(by_alias=True)
-        if doc["distinct"] is None:
-            del doc["distinct"]
+        for key in ("distinct", "distinct_sequences"):
+            if doc[key] is None:
+                del doc[key]
         if doc["cell"]["criterion"] is None:
             del doc["cell"]["criterion"]
         return json_ready(doc)

@@ -177,4 +177,5 @@ def run_slices(searcher, starts: list[Start], reward, rec: ClassRecorder, seed: 
                 break
     except Stop:
         pass
-    return Outcome(rec.episodes, tuple(rec.hazards), tuple(rec.top.best()), tuple(rec.risks))
+    return Outcome(rec.episodes, tuple(rec.hazards), tuple(rec.top.best()), tuple(rec.risks),
+                   rec.distinct_sequences)

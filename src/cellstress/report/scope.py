@@ -1,0 +1,57 @@
+"""What a search judged and what it covered, in words, for every output that reports one (the command line,
+report.html): the criterion that decided "unsafe", and, when nothing was found, what was tried. A search that
+finds nothing has not shown that there is nothing to find, and the words say so."""
+
+from __future__ import annotations
+
+from cellstress.cell.schema import CellSpec
+from cellstress.core.protocols import Criterion
+from cellstress.searchers.common import MAX_TRACKED
+from cellstress.searchers.result import SearchResult
+
+NOT_A_PROOF = ("A search is not a proof: it played these sequences, not every sequence, so a hazard may remain "
+               "(cellstress check gives the static ISO 13855 distances).")
+
+
+def judged_by(criterion: Criterion) -> str:
+    """``criterion NAME: what it calls unsafe``."""
+    return f"{criterion.type}: {criterion.describe()}"
+
+
+def search_scope(res: SearchResult, spec: CellSpec, cycle: float) -> str:
+    """The episodes, different action sequences, start points and robot phases a search covered."""
+    n = res.distinct_sequences
+    if n is None:
+        sequences = ""
+    else:
+        sequences = f" ({'at least ' if n >= MAX_TRACKED else ''}{n:,} different action sequences)"
+    per = spec.simulation.actions_per_episode
+    human = spec.human
+    if human.starts:
+        starts = ", ".join(f"{s.name} at ({s.xy[0]:g}, {s.xy[1]:g}) with the robot {_phase(s.phase, spec)} s into "
+                           "its cycle" for s in human.starts)
+        where = f"from {len(human.starts)} start points: {starts}"
+    else:
+        x, y = human.start.xy
+        where = f"from the start point ({x:g}, {y:g}) with the robot {_phase(None, spec)} s into its cycle"
+    return (f"{res.episodes:,} episodes of up to {per} actions{sequences}, {where} (cycle {cycle:.2f} s; other "
+            "arrival moments were not searched)")
+
+
+def _phase(phase: float | None, spec: CellSpec) -> str:
+    return f"{spec.robot.task.phase if phase is None else phase:g}"
+
+
+def strongest_contact(sim, actions) -> str | None:
+    """For a criterion that judges contacts (``iso15066``): its account of the strongest contact of an episode
+    (region, estimated force, limit), or None when the criterion has a fast path or the episode touches nothing.
+    A search that found no hazard shows it, so the reader sees how far below the limit the worst contact was."""
+    if sim.contacts is None:
+        return None
+    trace = sim.run(list(actions))
+    tol = sim.criterion.distance_tolerance
+    verdicts = [sim.verdict(row) for row, rec in zip(trace.rows, trace.records(), strict=True) if rec.d_HR <= tol]
+    if not verdicts:
+        return None
+    worst = max(verdicts, key=lambda v: getattr(v, "ratio", 0.0))
+    return worst.summary()
