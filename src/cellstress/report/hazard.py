@@ -5,7 +5,6 @@ contact seen from above and from the side, and the search's risk per episode.
 from __future__ import annotations
 
 import textwrap
-
 from dataclasses import dataclass
 
 import numpy as np

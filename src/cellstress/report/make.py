@@ -168,8 +168,8 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
                          "contact view"))
     body.append(H.figure(gif, f"The episode, one frame per {view.dt:g} s simulation step ({len(view.records)} frames, "
                          "shown at a quarter of real time).", "animated replay"))
-    body.append(H.figure(risk, "The search: each episode's maximum risk (the searcher's guide, not the verdict) and the "
-                         "highest so far; hazardous episodes in red.", "risk plot"))
+    body.append(H.figure(risk, "The search: each episode's maximum risk (the searcher's guide, not the verdict) "
+                         "and the highest so far; hazardous episodes in red.", "risk plot"))
     body.append("<h2>Actions</h2>")
     rows, classes = action_rows(view)
     body.append(H.table(["#", "action", "t [s]", "position at end [m]", "heading [deg]", "forward [deg]",

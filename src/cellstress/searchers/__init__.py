@@ -11,7 +11,6 @@ from __future__ import annotations
 from dataclasses import asdict, fields
 from pathlib import Path
 
-from cellstress.cell.schema import DEFAULT_CRITERION
 from cellstress.core import registry
 from cellstress.core.errors import PluginError
 from cellstress.core.version import __version__
