@@ -29,12 +29,13 @@ stack, rows = [], []
 
 class Listener(event.Listener):
     def on_start(self, ev):
-        stack.append([ev.data["dispatcher"].py_func.__qualname__, time.perf_counter(), 0.0])
+        stack.append([ev.data["dispatcher"].py_func.__qualname__, time.perf_counter(), 0.0,
+                      [str(a) for a in ev.data["args"]]])
 
     def on_end(self, ev):
-        name, start, inner = stack.pop()
+        name, start, inner, args = stack.pop()
         total = time.perf_counter() - start
-        rows.append((name, total, total - inner))
+        rows.append((name, total, total - inner, args))
         if stack:
             stack[-1][2] += total
 
@@ -77,7 +78,7 @@ def main() -> None:
     per: dict[str, list[tuple[float, float, int]]] = {}
     for r in runs:
         acc: dict[str, list[float]] = {}
-        for name, total, own in r["compiled"]:
+        for name, total, own, _ in r["compiled"]:
             x = acc.setdefault(name, [0.0, 0.0, 0])
             x[0] += own
             x[1] += total
@@ -98,6 +99,17 @@ def main() -> None:
     rest = sum(own for own, _, _, _ in table if own < 0.05)
     print(f"| (others, {sum(1 for t in table if t[0] < 0.05)} functions) | {rest:.2f} | | |")
     print(f"| **sum of own times** | {sum(t[0] for t in table):.2f} | | |")
+    # a function compiled for several signatures: which arguments' types differ (first run)
+    sigs: dict[str, list[list[str]]] = {}
+    for name, _, _, args in runs[0]["compiled"]:
+        sigs.setdefault(name, []).append(args)
+    for name, variants in sigs.items():
+        if len(variants) > 1 and name in {t[3] for t in table if t[0] >= 1.0}:
+            print(f"\n{name}: {len(variants)} signatures")
+            for i in range(max(len(v) for v in variants)):
+                kinds = {v[i] if i < len(v) else "-" for v in variants}
+                if len(kinds) > 1:
+                    print(f"  argument {i}: " + " | ".join(sorted(k[:160] for k in kinds)))
 
 
 if __name__ == "__main__":
