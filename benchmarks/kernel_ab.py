@@ -47,7 +47,9 @@ def main(argv=None) -> None:
                                      capture_output=True, text=True, check=True)
                 rates[tree].append(float(out.stdout.split()[-1]))
         a, b = statistics.median(rates[args.old]), statistics.median(rates[args.new])
-        print(f"{cell:20s} old {a:9,.0f}  new {b:9,.0f} episodes/s (one thread)  new/old {b / a:.2f}")
+        print(f"{cell:20s} old {a:9,.0f}  new {b:9,.0f} episodes/s (one thread)  new/old {b / a:.2f}"
+              f"   (rounds: old {' '.join(f'{r:,.0f}' for r in rates[args.old])};"
+              f" new {' '.join(f'{r:,.0f}' for r in rates[args.new])})", flush=True)
 
 
 if __name__ == "__main__":

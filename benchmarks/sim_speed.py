@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
 
 CELLS = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap")
@@ -72,7 +72,7 @@ def main(argv=None) -> None:
         state = sim.reset()
         rows.append((cell, statistics.median(b), min(b), statistics.median(s), min(s),
                      sim.layout.reach.nbytes,
-                     state.nbytes, K.NM * 8))
+                     state.nbytes, L.NM * 8))
         print(f"# {cell}: done", flush=True)
 
     print()

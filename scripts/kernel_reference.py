@@ -59,7 +59,7 @@ def same_bits(a: np.ndarray, b: np.ndarray) -> bool:
 
 def compare(old: dict, new: dict) -> int:
     """Print how far NEW's outputs moved from OLD's; 1 if the unsafe outcomes differ."""
-    from cellstress.sim import kernels as K
+    from cellstress.sim import layout as L
 
     changed_outcome = False
     for c in CELLS:
@@ -74,9 +74,9 @@ def compare(old: dict, new: dict) -> int:
             print(f"{c}: traces differ in length")
             changed_outcome = True
             continue
-        dr = np.abs(rows_old[:, K.M_D] - rows_new[:, K.M_D])
-        near = (rows_old[:, K.M_D] < 0.05) | (rows_new[:, K.M_D] < 0.05)
-        who = (rows_old[:, K.M_LINK] != rows_new[:, K.M_LINK]) | (rows_old[:, K.M_PART] != rows_new[:, K.M_PART])
+        dr = np.abs(rows_old[:, L.M_D] - rows_new[:, L.M_D])
+        near = (rows_old[:, L.M_D] < 0.05) | (rows_new[:, L.M_D] < 0.05)
+        who = (rows_old[:, L.M_LINK] != rows_new[:, L.M_LINK]) | (rows_old[:, L.M_PART] != rows_new[:, L.M_PART])
         n_unsafe = int((new[f"{c}:unsafe_step"] >= 0).sum())
         print(f"{c}: unsafe episodes {'same' if same_unsafe else 'DIFFER'} ({n_unsafe} of {len(a)}); "
               f"d_end moved in {int((dd > 0).sum())} of {dd.size} (max {dd.max(initial=0):.2e} m, "

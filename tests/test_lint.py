@@ -23,3 +23,10 @@ def test_version_is_single():
 
     doc = tomllib.loads((ROOT / "pyproject.toml").read_text())
     assert doc["project"]["version"] == cellstress.__version__
+
+
+def test_no_source_file_is_longer_than_500_lines():
+    """The project's rule: a module a reader can hold in mind (split by concern, as sim/kernels/ is)."""
+    long = {str(p.relative_to(ROOT)): n for p in sorted((ROOT / "src").rglob("*.py"))
+            if (n := len(p.read_text().splitlines())) > 500}
+    assert not long, long

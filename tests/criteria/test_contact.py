@@ -7,7 +7,7 @@ import pytest
 
 from cellstress.core.records import Measures
 from cellstress.criteria.contact import ContactWhileMoving
-from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
 
 
@@ -40,11 +40,11 @@ def test_simulator_flags_exactly_the_criterion():
         rows = sim.run(seq).rows
         for r in rows:
             # the kernel compares the signed distance; a reported 0.0 may be an overlap, so check one way
-            if r[K.M_UNSAFE]:
+            if r[L.M_UNSAFE]:
                 flagged += 1
-                assert crit.is_unsafe(r[K.M_D], r[K.M_V])
-            elif r[K.M_D] > 0.0:
-                assert not crit.is_unsafe(r[K.M_D], r[K.M_V])
+                assert crit.is_unsafe(r[L.M_D], r[L.M_V])
+            elif r[L.M_D] > 0.0:
+                assert not crit.is_unsafe(r[L.M_D], r[L.M_V])
             else:  # touching but not flagged: the robot must be standing still
-                assert r[K.M_V] <= crit.speed_tolerance
+                assert r[L.M_V] <= crit.speed_tolerance
     assert flagged > 0

@@ -25,6 +25,7 @@ from cellstress.human.actions import action_index
 from cellstress.human.regions import body_region
 from cellstress.robot.dynamics import point_dynamics, reflected_mass
 from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.determinism import check_determinism
 from cellstress.sim.scene import body_pose
 from cellstress.sim.simulator import Simulator
@@ -102,7 +103,7 @@ def test_hand_contact_at_low_speed_is_safe_under_iso_but_not_under_the_paper():
     iso = Simulator(with_criterion(load_cell("s3-fence-gap"), "iso15066"))
     trace = iso.run(S3_WITNESS)
     assert not trace.unsafe
-    touching = [r for r in trace.rows if r[K.M_D] <= 0.0]
+    touching = [r for r in trace.rows if r[L.M_D] <= 0.0]
     assert touching  # the same contact happens, it is just not unsafe
     for r in touching:
         c = iso.verdict(r)
@@ -184,7 +185,7 @@ def _strict_s3() -> Simulator:
 def test_simulator_applies_the_criterion_the_same_way_everywhere():
     sim = _strict_s3()
     trace = sim.run(S3_WITNESS)
-    assert trace.unsafe and trace.rows[-1, K.M_UNSAFE] == 1.0 and trace.unsafe_row == len(trace.rows) - 1
+    assert trace.unsafe and trace.rows[-1, L.M_UNSAFE] == 1.0 and trace.unsafe_row == len(trace.rows) - 1
     rng = np.random.default_rng(5)
     seqs = [S3_WITNESS + ["walk+upright"] * 4, *rng.integers(0, 30, (40, 8)).tolist()]
     assert check_determinism(sim, seqs) == len(seqs)
@@ -200,21 +201,21 @@ def test_contact_point_velocity_matches_the_kernel_kinematics():
 
     sim = Simulator(with_criterion(load_cell("s3-fence-gap"), "iso15066"))
     P, fm = sim.params, sim.contacts
-    rows = [r for r in sim.run(S3_WITNESS).rows if r[K.M_D] <= 0.0]
+    rows = [r for r in sim.run(S3_WITNESS).rows if r[L.M_D] <= 0.0]
     assert rows
     W = K.make_work(P)
 
     def joint_frame(j, tau):
-        K.robot_live(P, tau - P.scal[K.C_PHASE0], np.inf, W)
+        K.robot_live(P, tau - P.scal[L.C_PHASE0], np.inf, W)
         return W.rot[j].copy(), W.pos[j].copy()
 
     for r in rows:
-        assert int(r[K.M_PHASE]) == K.PHASE_RUNNING  # sigma = 1: path velocity = time velocity
-        j = int(P.cap_joint[int(r[K.M_LINK])])
-        rp = np.array(r[K.M_RX:K.M_RZ + 1])
+        assert int(r[L.M_PHASE]) == L.PHASE_RUNNING  # sigma = 1: path velocity = time velocity
+        j = int(P.cap_joint[int(r[L.M_LINK])])
+        rp = np.array(r[L.M_RX:L.M_RZ + 1])
         q, qd = scene.joint_state(sim.layout, r)
-        (R0, o0), (R1, o1) = joint_frame(j, r[K.M_TAU] - 1e-6), joint_frame(j, r[K.M_TAU] + 1e-6)
-        Rm, om = joint_frame(j, r[K.M_TAU])
+        (R0, o0), (R1, o1) = joint_frame(j, r[L.M_TAU] - 1e-6), joint_frame(j, r[L.M_TAU] + 1e-6)
+        Rm, om = joint_frame(j, r[L.M_TAU])
         local = Rm.T @ (rp - om)
         v_fd = ((R1 @ local + o1) - (R0 @ local + o0)) / 2e-6
         Jp, _ = point_dynamics(fm.model, fm.data, q, j + 1, fm.R_base.T @ (rp - fm.t_base))
@@ -236,15 +237,15 @@ def test_a_criterion_step_inside_an_action_leaves_the_state_of_that_step():
             if not sim.is_unsafe(s):
                 continue
             row = rows[-1]
-            assert s[K.S_K] == row[K.M_STEP] and sim.time(s) == row[K.M_STEP]
-            assert (s[K.S_X], s[K.S_Y], s[K.S_HEADING], s[K.S_FWD], s[K.S_LAT]) == \
-                (row[K.M_X], row[K.M_Y], row[K.M_HEADING], row[K.M_FWD], row[K.M_LAT])
+            assert s[L.S_K] == row[L.M_STEP] and sim.time(s) == row[L.M_STEP]
+            assert (s[L.S_X], s[L.S_Y], s[L.S_HEADING], s[L.S_FWD], s[L.S_LAT]) == \
+                (row[L.M_X], row[L.M_Y], row[L.M_HEADING], row[L.M_FWD], row[L.M_LAT])
             if len(rows) < P.spa:
                 mid_action += 1
-                again, again_row = s.copy(), np.zeros(K.NM)
+                again, again_row = s.copy(), np.zeros(L.NM)
                 K.sense_and_measure(P, again, K.make_work(P), again_row, a)
-                np.testing.assert_array_equal(again[:K.S_UNSAFE], s[:K.S_UNSAFE])
-                for col in (K.M_D, K.M_V, K.M_SEEN, K.M_PHASE, K.M_TAU, K.M_LINK, K.M_PART):
+                np.testing.assert_array_equal(again[:L.S_UNSAFE], s[:L.S_UNSAFE])
+                for col in (L.M_D, L.M_V, L.M_SEEN, L.M_PHASE, L.M_TAU, L.M_LINK, L.M_PART):
                     assert again_row[col] == row[col], col
             break
     assert mid_action >= 5  # the case this test is about happened (11 times in these 6,000 episodes)

@@ -12,6 +12,7 @@ import pytest
 
 from cellstress.robot.trajectory import MIN_SEGMENT_TIME, evaluate
 from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 
 N_CONFIGS = 300
 FK_ATOL = 1e-12  # metres / rotation-matrix entries; both sides are double-precision products of ~6 matrices
@@ -132,7 +133,7 @@ def test_robot_live_v_R_matches_pinocchio_along_the_task(setup):
     moving = 0
     for t in ts:
         v, phase, tau = K.robot_live(P, t, np.inf, W)
-        assert phase == K.PHASE_RUNNING
+        assert phase == L.PHASE_RUNNING
         q, qd = evaluate(traj, tau)
         ref, _ = pin_fastest_joint_speed(model, data, P.base, q, qd)
         assert v == pytest.approx(ref, rel=V_RTOL, abs=1e-12)
@@ -140,7 +141,7 @@ def test_robot_live_v_R_matches_pinocchio_along_the_task(setup):
     assert moving > 100  # the check covered the robot in motion, not only dwells
     # the pre-stop table the simulator uses holds the same numbers
     k = np.arange(0, P.pre_v.shape[0], 7)
-    dt = P.scal[K.C_DT]
+    dt = P.scal[L.C_DT]
     for kk in k:
         v, _, tau = K.robot_live(P, kk * dt, np.inf, W)
         assert P.pre_v[kk] == v and P.pre_tau[kk] == tau

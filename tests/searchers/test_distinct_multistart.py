@@ -13,7 +13,7 @@ from cellstress.core.errors import ActionError
 from cellstress.searchers import search
 from cellstress.searchers.distinct import hazard_class
 from cellstress.searchers.multistart import MultiStartProblem
-from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
 
 
@@ -32,7 +32,7 @@ def test_start_token_replays_exactly(af):
     p = MultiStartProblem(af)
     assert p.actions_per_episode == 9 and p.choices(0) == 3 and p.choices(1) == 30
     state, rows = p.step(p.reset(), 4)  # 4 % 3 = start 1
-    assert state[0] == 1 and rows[0, K.M_X] == 0.0 and rows[0, K.M_Y] == -2.5
+    assert state[0] == 1 and rows[0, L.M_X] == 0.0 and rows[0, L.M_Y] == -2.5
     parts = [rows]
     for a in (0, 6, 12):
         state, r = p.step(state, a)

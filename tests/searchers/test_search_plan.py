@@ -15,7 +15,7 @@ from cellstress.cli import main
 from cellstress.criteria.contact import ContactWhileMoving
 from cellstress.searchers import SearchError, run_search, searcher_class
 from cellstress.searchers.plan import Plan, _Model
-from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
 
 FLAWED = ("s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap")
@@ -117,8 +117,8 @@ def test_robot_points_learned_in_one_episode_hold_in_every_other(cell, tmp_path)
     real = np.empty(len(fresh))
     for i, actions in enumerate(fresh):
         rows = sim.run(actions).rows[1:]
-        moving = rows[:, K.M_V] > model.v_tol
-        real[i] = rows[moving, K.M_D].min() if moving.any() else np.inf
+        moving = rows[:, L.M_V] > model.v_tol
+        real[i] = rows[moving, L.M_D].min() if moving.any() else np.inf
     known = np.isfinite(predicted)
     assert known.sum() > 300
     bound = np.maximum(predicted[known], 0.0)  # (a penetration is negative; d_HR stops at 0)

@@ -12,7 +12,7 @@ import yaml
 
 from cellstress.cell.load import builtin_text, parse_cell
 from cellstress.human.actions import action_index
-from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
 
 BODIES = ["upright", "bend-forward", "bend-left", "bend-right", "bend-forward-left", "bend-forward-right"]
@@ -61,7 +61,7 @@ def attack(name: str, n_phases: int, starts) -> tuple[int, float, int]:
         sim = with_phase(name, phase)
         for start in starts:
             s = sim.with_start(start)
-            assert s.initial_metrics()[K.M_SEEN] == 0, f"start {start} is inside a detection zone"
+            assert s.initial_metrics()[L.M_SEEN] == 0, f"start {start} is inside a detection zone"
             res = s.run_batch(acts)
             unsafe += int(res.unsafe.sum())
             lo = min(lo, float(res.min_d.min()))

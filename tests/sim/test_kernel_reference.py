@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "kernel_reference.py"
 
@@ -27,8 +27,8 @@ def recording(mod, seed: int = 0) -> dict[str, np.ndarray]:
         out[f"{c}:unsafe_step"] = np.full(20, -1)
         for name, n in (("run", 200), ("step", 300)):
             for i in range(n):
-                rows = np.zeros((3, K.NM))
-                rows[:, K.M_D] = rng.uniform(0.1, 2.0, size=3)
+                rows = np.zeros((3, L.NM))
+                rows[:, L.M_D] = rng.uniform(0.1, 2.0, size=3)
                 out[f"{c}:{name}{i}"] = rows
     return out
 
@@ -44,8 +44,8 @@ def test_compare_reports_moves_and_outcome_changes(capsys):
     new = {k: v.copy() for k, v in old.items()}
     cell = mod.CELLS[-1]
     new[f"{cell}:d_end"][3, 2] += 0.004  # a 4 mm move, far from contact
-    new[f"{cell}:run7"][1, K.M_D] = 0.03  # a trace row moved to within 5 cm of contact
-    new[f"{cell}:step9"][0, K.M_PART] = 2.0  # another closest body part
+    new[f"{cell}:run7"][1, L.M_D] = 0.03  # a trace row moved to within 5 cm of contact
+    new[f"{cell}:step9"][0, L.M_PART] = 2.0  # another closest body part
     assert mod.compare(old, new) == 0  # unsafe outcomes unchanged
     line = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith(cell)][0]
     assert "d_end moved in 1 of 160 (max 4.00e-03 m" in line

@@ -9,6 +9,7 @@ import pytest
 from cellstress.core.protocols import Lookahead as LookaheadAbility
 from cellstress.human.actions import action_index
 from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.lookahead import Lookahead, default_horizon
 from cellstress.sim.simulator import Simulator
 
@@ -25,21 +26,21 @@ def brute_gaps(sim, rows, t_stop, horizon, speed):
     kernels.sense_and_measure (the simulator's step, minus the walking); min of d_HR - speed * j * dt."""
     P, dt = sim.params, sim.dt
     W = K.make_work(P)
-    vtol = P.scal[K.C_VTOL]
+    vtol = P.scal[L.C_VTOL]
     out = []
     for r in rows:
         best = np.inf
         for j in range(int(round(horizon / dt)) + 1):
-            s = np.zeros(K.NS)
-            s[K.S_K] = r[K.M_STEP] + j
-            s[K.S_X], s[K.S_Y], s[K.S_HEADING], s[K.S_FWD], s[K.S_LAT] = (
-                r[K.M_X], r[K.M_Y], r[K.M_HEADING], r[K.M_FWD], r[K.M_LAT])
-            s[K.S_TSTOP] = np.inf if r[K.M_PHASE] == K.PHASE_RUNNING else t_stop
-            s[K.S_TRIG_DEV] = s[K.S_TRIG_T] = -1.0
-            row = np.zeros(K.NM)
+            s = np.zeros(L.NS)
+            s[L.S_K] = r[L.M_STEP] + j
+            s[L.S_X], s[L.S_Y], s[L.S_HEADING], s[L.S_FWD], s[L.S_LAT] = (
+                r[L.M_X], r[L.M_Y], r[L.M_HEADING], r[L.M_FWD], r[L.M_LAT])
+            s[L.S_TSTOP] = np.inf if r[L.M_PHASE] == L.PHASE_RUNNING else t_stop
+            s[L.S_TRIG_DEV] = s[L.S_TRIG_T] = -1.0
+            row = np.zeros(L.NM)
             K.sense_and_measure(P, s, W, row, -1)
-            if row[K.M_V] > vtol:
-                best = min(best, row[K.M_D] - speed * j * dt)
+            if row[L.M_V] > vtol:
+                best = min(best, row[L.M_D] - speed * j * dt)
         out.append(best)
     return np.array(out)
 
@@ -52,14 +53,14 @@ def test_gaps_match_brute_force(cell) -> None:
     state, phases = sim.reset(), set()
     for a in EPISODES[cell]:
         state, rows = sim.step(state, action_index(a))
-        got = la.gaps(rows, state[K.S_TSTOP])
-        want = brute_gaps(sim, rows, state[K.S_TSTOP], la.horizon, la.speed)
+        got = la.gaps(rows, state[L.S_TSTOP])
+        want = brute_gaps(sim, rows, state[L.S_TSTOP], la.horizon, la.speed)
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
-        phases |= set(rows[:, K.M_PHASE].astype(int).tolist())
+        phases |= set(rows[:, L.M_PHASE].astype(int).tolist())
         if sim.is_unsafe(state):
             break
     # the episodes cover the running robot and a requested stop
-    assert K.PHASE_RUNNING in phases and phases - {K.PHASE_RUNNING}
+    assert L.PHASE_RUNNING in phases and phases - {L.PHASE_RUNNING}
     if cell == "s2-elbow-intrusion":
         assert sim.is_unsafe(state)
 
@@ -72,11 +73,11 @@ def test_zero_window_is_d_hr_of_the_moving_robot() -> None:
     for a in ["walk+upright"] * 2 + ["turn-left-45+upright", "turn-right-45+upright"] * 3:
         state, rows = sim.step(state, action_index(a))
         rows_all.append(rows)
-        gaps.append(la.gaps(rows, state[K.S_TSTOP]))
+        gaps.append(la.gaps(rows, state[L.S_TSTOP]))
     rows, gaps = np.concatenate(rows_all), np.concatenate(gaps)
-    moving = rows[:, K.M_V] > sim.params.scal[K.C_VTOL]
+    moving = rows[:, L.M_V] > sim.params.scal[L.C_VTOL]
     assert moving.any() and not moving.all()  # the S2 robot dwells in its fold for 0.2 s (t = 0.37-0.57 s)
-    np.testing.assert_allclose(gaps[moving], rows[moving, K.M_D], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(gaps[moving], rows[moving, L.M_D], rtol=0, atol=1e-12)
     assert np.isinf(gaps[~moving]).all()
 
 
@@ -85,19 +86,19 @@ def test_lookahead_leaves_the_simulator_alone() -> None:
     la = Lookahead(sim.params, horizon=0.3, speed=0.0)
     s0 = sim.reset()
     s1, rows1 = sim.step(s0, 0)
-    la.gaps(rows1, s1[K.S_TSTOP])
+    la.gaps(rows1, s1[L.S_TSTOP])
     s2, rows2 = sim.step(s0, 0)
     assert np.array_equal(s1, s2) and np.array_equal(rows1, rows2)
     # the gap never exceeds d_HR now (tau = 0 is in the window) while the robot moves
-    g = la.gaps(rows1, s1[K.S_TSTOP])
-    assert (g <= rows1[:, K.M_D] + 1e-12).all()
+    g = la.gaps(rows1, s1[L.S_TSTOP])
+    assert (g <= rows1[:, L.M_D] + 1e-12).all()
 
 
 def test_the_simulator_exposes_it() -> None:
     sim = Simulator("s2-elbow-intrusion")
     state, rows = sim.step(sim.reset(), action_index("walk+upright"))
-    direct = Lookahead(sim.params, 0.3, 1.0).gaps(rows, state[K.S_TSTOP])
-    np.testing.assert_array_equal(sim.lookahead_model(0.3, 1.0).gaps(rows, state[K.S_TSTOP]), direct)
+    direct = Lookahead(sim.params, 0.3, 1.0).gaps(rows, state[L.S_TSTOP])
+    np.testing.assert_array_equal(sim.lookahead_model(0.3, 1.0).gaps(rows, state[L.S_TSTOP]), direct)
     np.testing.assert_array_equal(sim.lookahead(state, rows, 0.3, 1.0), direct)
     assert isinstance(sim, LookaheadAbility)
     assert sim.lookahead_model().horizon == pytest.approx(0.05 + 0.15)  # the curtain's response + stopping time

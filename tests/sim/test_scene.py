@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim import scene
 from cellstress.sim.simulator import Simulator
 
@@ -47,7 +48,7 @@ def test_reach_points_are_inside_the_kernels_reach_volume():
     K.human_pose(P, *args, W)
     np.testing.assert_array_equal(pose.a, W.ha)
     np.testing.assert_array_equal(pose.shoulders, W.sh)
-    n_near = K.near_fences(P, W, P.body[K.B_ARM_LEN] + 0.05)
+    n_near = K.near_fences(P, W, P.body[L.B_ARM_LEN] + 0.05)
     assert n_near > 0  # S3's contact is made around a fence end: the detour test is exercised
     side = 0 if r.body_part == "left-reach" else 1
     pts = scene.reach_points(sim.layout, pose, side)

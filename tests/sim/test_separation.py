@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim import scene
 from cellstress.sim.geometry import segment_segment_xyz
 from cellstress.sim.simulator import Simulator
@@ -29,17 +30,17 @@ def brute_force_d(sim: Simulator, row: np.ndarray) -> tuple[float, int, dict[tup
     body part) pair) for one metric row."""
     P = sim.params
     W = K.make_work(P)
-    K.human_pose(P, row[K.M_X], row[K.M_Y], row[K.M_HEADING], row[K.M_FWD], row[K.M_LAT], W)
-    n_near = int(K.near_fences(P, W, P.body[K.B_ARM_LEN] + 0.05))
-    ra, rb = scene.robot_capsules(sim.layout, row[K.M_TAU])
+    K.human_pose(P, row[L.M_X], row[L.M_Y], row[L.M_HEADING], row[L.M_FWD], row[L.M_LAT], W)
+    n_near = int(K.near_fences(P, W, P.body[L.B_ARM_LEN] + 0.05))
+    ra, rb = scene.robot_capsules(sim.layout, row[L.M_TAU])
     pairs: dict[tuple[int, int], float] = {}
     for c in range(len(P.cap_r)):
         r = float(P.cap_r[c])
         n = max(2, int(np.linalg.norm(rb[c] - ra[c]) / SAMPLE) + 1)
         for side in (0, 1):
-            pairs[c, K.PART_LEFT_REACH + side] = min(float(K.reach_value(P, p, side, W, n_near)) - r
+            pairs[c, L.PART_LEFT_REACH + side] = min(float(K.reach_value(P, p, side, W, n_near)) - r
                                                      for p in np.linspace(ra[c], rb[c], n))
-        for h in range(K.N_BODY_CAPSULES):
+        for h in range(L.N_BODY_CAPSULES):
             d2 = segment_segment_xyz(*ra[c], *rb[c], *W.ha[h], *W.hb[h])[0]
             pairs[c, h] = math.sqrt(d2) - r - float(W.hr[h])
     return min(pairs.values()), n_near, pairs
@@ -59,16 +60,16 @@ def sampled_rows(sim: Simulator, episodes: int, seed: int) -> list[np.ndarray]:
 @pytest.mark.parametrize("cell", ["s3-fence-gap", "baseline"])
 def test_kernel_d_hr_matches_brute_force(cell):
     sim = Simulator(cell)
-    h = float(sim.params.scal[K.C_REACH_H])
+    h = float(sim.params.scal[L.C_REACH_H])
     near_checked = 0
     for row in sampled_rows(sim, 40, seed=5):
         brute, n_near, pairs = brute_force_d(sim, row)
         near_checked += n_near > 0
-        d = float(row[K.M_D])
-        step = int(row[K.M_STEP])
+        d = float(row[L.M_D])
+        step = int(row[L.M_STEP])
         # the closest robot link and body part it names really come that close (a stand-in value that passed
         # for a new best named the wrong pair in session 3, with d still right)
-        assert pairs[int(row[K.M_LINK]), int(row[K.M_PART])] <= max(d, 0.0) + SAMPLE, (step, d, pairs)
+        assert pairs[int(row[L.M_LINK]), int(row[L.M_PART])] <= max(d, 0.0) + SAMPLE, (step, d, pairs)
         if brute <= 0.0:
             assert d == 0.0, (step, brute)
             continue

@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
 
-POSE = [K.M_X, K.M_Y, K.M_HEADING, K.M_FWD, K.M_LAT]
+POSE = [L.M_X, L.M_Y, L.M_HEADING, L.M_FWD, L.M_LAT]
 
 
 @pytest.mark.parametrize("cell", ["baseline", "s2-elbow-intrusion", "s3-fence-gap"])
@@ -43,10 +43,10 @@ def test_distance_to_the_robot_point_of_a_row_is_its_d_hr(cell) -> None:
     acts = np.random.default_rng(9).integers(0, sim.n_actions, size=(60, sim.actions_per_episode))
     rows = np.concatenate([sim.run(a).rows[1:] for a in acts])
     # within reach, and not touching (a row reports a penetration as d_HR = 0)
-    rows = rows[(rows[:, K.M_D] < 0.8) & (rows[:, K.M_D] > 0.0)]
-    points = rows[:, None, [K.M_RX, K.M_RY, K.M_RZ]]
+    rows = rows[(rows[:, L.M_D] < 0.8) & (rows[:, L.M_D] > 0.0)]
+    points = rows[:, None, [L.M_RX, L.M_RY, L.M_RZ]]
     dist = sim.worker_distances(rows[:, POSE], points)[:, 0]
-    d = rows[:, K.M_D]
+    d = rows[:, L.M_D]
     gap = dist - d
     assert len(rows) > 300
     # d_HR itself may be long by the reach trace's tolerance far from contact: one 2 cm grid step plus 5 %

@@ -10,6 +10,7 @@ import numpy as np
 
 from cellstress.analysis.plane import point_segment
 from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 
 SAMPLE_DT = 0.01  # s between robot poses when sampling the hazard zone
 
@@ -100,7 +101,7 @@ def hazard_zone(layout, sample_dt: float = SAMPLE_DT) -> HazardZone:
     """Sample the robot capsules over one cycle (before any stop) into floor stadiums."""
     P = layout.params
     W = K.make_work(P)
-    cycle = float(P.scal[K.C_CYCLE])
+    cycle = float(P.scal[L.C_CYCLE])
     ts = np.arange(0.0, cycle, sample_dt)
     nc = P.cap_r.shape[0]
     ra = np.empty((len(ts), nc, 3))

@@ -44,7 +44,9 @@ from cellstress.analysis.plane import (
 )
 from cellstress.cell.load import Cell, load_cell
 from cellstress.core.records import ScanPlane, VerticalField
+from cellstress.human.body import WALK_BLOCK_HEIGHT
 from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.build import build_layout
 
 GRID = 0.05  # m, flood-fill grid
@@ -136,12 +138,12 @@ class StaticCheck:
 
 def _upright_capsule_bands(body: np.ndarray) -> list[tuple[float, float, float]]:
     """(z low, z high, radius) of the upright worker's body capsules (kernels.human_pose at zero flexion)."""
-    hip = body[K.B_HIP_Z]
-    shoulder = hip + body[K.B_SHOULDER_RISE]
-    arm_low = max(shoulder - (body[K.B_ARM_LEN] - body[K.B_R_ARM]), body[K.B_R_ARM])
-    head = hip + body[K.B_HEAD_RISE]
-    rl, rt, rh, ra = body[K.B_R_LEG], body[K.B_R_TRUNK], body[K.B_R_HEAD], body[K.B_R_ARM]
-    return [(0.0, hip + rl, rl), (hip - rt, hip + body[K.B_TRUNK_TOP] + rt, rt),
+    hip = body[L.B_HIP_Z]
+    shoulder = hip + body[L.B_SHOULDER_RISE]
+    arm_low = max(shoulder - (body[L.B_ARM_LEN] - body[L.B_R_ARM]), body[L.B_R_ARM])
+    head = hip + body[L.B_HEAD_RISE]
+    rl, rt, rh, ra = body[L.B_R_LEG], body[L.B_R_TRUNK], body[L.B_R_HEAD], body[L.B_R_ARM]
+    return [(0.0, hip + rl, rl), (hip - rt, hip + body[L.B_TRUNK_TOP] + rt, rt),
             (head - rh, head + rh, rh), (arm_low - ra, shoulder + ra, ra)]
 
 
@@ -172,7 +174,7 @@ def lean_reach(layout) -> float:
 
 
 def _walk_blocking_fences(spec):
-    return [(a, b) for f in spec.fences if f.bottom < K.WALK_BLOCK_HEIGHT
+    return [(a, b) for f in spec.fences if f.bottom < WALK_BLOCK_HEIGHT
             for a, b in zip(f.points, f.points[1:], strict=False)]
 
 
@@ -245,7 +247,7 @@ def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowan
     from scipy import ndimage
 
     body = layout.params.body
-    radius = float(body[K.B_BODY_RADIUS])
+    radius = float(body[L.B_BODY_RADIUS])
     fl = spec.floor
     h = GRID
     nx = int(round((fl.xmax - fl.xmin) / h))
@@ -319,13 +321,13 @@ def check_cell(cell: Cell | str | Path, layout=None) -> StaticCheck:
         layout = build_layout(cell)
     spec = layout.cell.spec
     body = layout.params.body
-    shoulder = float(body[K.B_HIP_Z] + body[K.B_SHOULDER_RISE])
+    shoulder = float(body[L.B_HIP_Z] + body[L.B_SHOULDER_RISE])
     zone = hazard_zone(layout)
     devices = _device_checks(spec, zone)
     panels = _fence_panels(spec, zone, shoulder, ARM_ALLOWANCE)
     lean = lean_reach(layout)
     approach = _approach_check(spec, layout, zone, panels, lean, ARM_ALLOWANCE)
-    return StaticCheck(spec.name, zone, devices, approach, panels, shoulder, float(body[K.B_ARM_LEN]),
+    return StaticCheck(spec.name, zone, devices, approach, panels, shoulder, float(body[L.B_ARM_LEN]),
                        episode_length(spec))
 
 

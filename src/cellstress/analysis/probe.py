@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit
 
 from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
 
 FLEX = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (0.0, -1.0), (1.0, 1.0), (1.0, -1.0))  # (forward, lateral) fractions
@@ -33,10 +34,10 @@ def _unseen_and_clear(P, W):
 @njit(cache=True)
 def _closest(P, W, ras, rbs, row):
     """min over the robot poses (ras[k], rbs[k]) of d_HR for the worker pose in W; (d, pose index)."""
-    n_near = K.collect_near_fences(P.fences, W.sh, W.near, P.body[K.B_ARM_LEN] + 0.05)
+    n_near = K.collect_near_fences(P.fences, W.sh, W.near, P.body[L.B_ARM_LEN] + 0.05)
     best, arg = np.inf, -1
     for k in range(ras.shape[0]):
-        d = K.separation(P.cap_r, P.reach, P.scal[K.C_REACH_ORIGIN], P.scal[K.C_REACH_H], P.body[K.B_ARM_LEN],
+        d = K.separation(P.cap_r, P.reach, P.scal[L.C_REACH_ORIGIN], P.scal[L.C_REACH_H], P.body[L.B_ARM_LEN],
                          P.fences, W.near, ras[k], rbs[k], W.sh, W.tr, W.ha, W.hb, W.hr, W.lbs, W.ts, W.best_r,
                          n_near, row)
         if d < best:
@@ -49,18 +50,18 @@ def probe(cell: str = "s2-elbow-intrusion", step: float = 0.05) -> dict:
     sim = Simulator(cell)
     P, lay = sim.params, sim.layout
     W = K.make_work(P)
-    dt, cycle, phase0 = float(P.scal[K.C_DT]), float(P.scal[K.C_CYCLE]), float(P.scal[K.C_PHASE0])
+    dt, cycle, phase0 = float(P.scal[L.C_DT]), float(P.scal[L.C_CYCLE]), float(P.scal[L.C_PHASE0])
     times = np.arange(0.0, cycle, dt) - phase0  # the robot's whole cycle
     ras = np.empty((len(times), *W.ra.shape))
     rbs = np.empty_like(ras)
     for k, t in enumerate(times):
         K.robot_live(P, t, np.inf, W)
         ras[k], rbs[k] = W.ra, W.rb
-    curtain = next(i for i, kind in enumerate(P.dev_kind) if kind == K.DEV_CURTAIN)
+    curtain = next(i for i, kind in enumerate(P.dev_kind) if kind == L.DEV_CURTAIN)
     y_line = float(min(P.dev_rect[curtain, 1], P.dev_rect[curtain, 3]))
     hum = sim.cell.spec.human
     fwd_max, lat_max = math.radians(hum.max_forward_flexion_deg), math.radians(hum.max_lateral_flexion_deg)
-    row = np.zeros(K.NM)
+    row = np.zeros(L.NM)
     out = {"cell": cell, "curtain_y": y_line, "poses": 0, "unseen": 0, "robot_poses": len(times), "d": math.inf}
     for x in np.arange(-0.6, 0.6 + 1e-9, step):
         for y in np.arange(y_line - 0.35, y_line + 1e-9, step):
@@ -75,5 +76,5 @@ def probe(cell: str = "s2-elbow-intrusion", step: float = 0.05) -> dict:
                     if d < out["d"]:
                         out.update(d=float(d), x=round(float(x), 3), y=round(float(y), 3), heading_deg=heading_deg,
                                    posture=(f, lat), path_time=round(float(times[k] + phase0), 3),
-                                   link=lay.capsules[int(row[K.M_LINK])].name, part=int(row[K.M_PART]))
+                                   link=lay.capsules[int(row[L.M_LINK])].name, part=int(row[L.M_PART]))
     return out

@@ -27,7 +27,7 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 
 from cellstress.cell.load import Cell, load_cell, with_criterion
-from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.simulator import STOP_PHASES, Simulator
 from cellstress.sim.starts import start_simulator
 
@@ -69,9 +69,9 @@ def observation_space(sim: Simulator) -> spaces.Box:
 
 def observe(row: np.ndarray) -> np.ndarray:
     """The observation of one metric row."""
-    h = row[K.M_HEADING]
-    return np.array([row[K.M_T], row[K.M_X], row[K.M_Y], np.cos(h), np.sin(h), row[K.M_FWD], row[K.M_LAT],
-                     row[K.M_PHASE], row[K.M_D], row[K.M_V], row[K.M_TAU]], dtype=np.float64)
+    h = row[L.M_HEADING]
+    return np.array([row[L.M_T], row[L.M_X], row[L.M_Y], np.cos(h), np.sin(h), row[L.M_FWD], row[L.M_LAT],
+                     row[L.M_PHASE], row[L.M_D], row[L.M_V], row[L.M_TAU]], dtype=np.float64)
 
 
 class CellEnv(gymnasium.Env):
@@ -109,9 +109,9 @@ class CellEnv(gymnasium.Env):
         return observe(row), float(reward), bool(unsafe), bool(last and not unsafe), self._info(row, risk)
 
     def _info(self, row: np.ndarray, risk: float) -> dict[str, Any]:
-        seen = int(row[K.M_SEEN])
-        return {"d_HR": float(row[K.M_D]), "v_R": float(row[K.M_V]), "risk": float(risk),
-                "stop_phase": STOP_PHASES[int(row[K.M_PHASE])], "unsafe": bool(row[K.M_UNSAFE]),
+        seen = int(row[L.M_SEEN])
+        return {"d_HR": float(row[L.M_D]), "v_R": float(row[L.M_V]), "risk": float(risk),
+                "stop_phase": STOP_PHASES[int(row[L.M_PHASE])], "unsafe": bool(row[L.M_UNSAFE]),
                 "devices": [n for i, n in enumerate(self.sim.layout.device_names) if seen >> i & 1]}
 
 

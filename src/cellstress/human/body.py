@@ -13,6 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cellstress.core.vector_spec import VectorSpec
+
 BODY_PARTS: tuple[str, ...] = (
     "left-leg",
     "right-leg",
@@ -27,10 +29,27 @@ N_CAPSULES = 6  # the first six parts are capsules; the last two are the reach v
 BODY_RADIUS = 0.20  # m, the footprint that keeps the body centre from fences and table edges
 WALK_BLOCK_HEIGHT = 0.5  # m: a fence panel whose bottom is above this does not stop walking (the worker ducks)
 
-# Indices into the body parameter vector used by the kernel.
-B_HIP_Z, B_SHOULDER_RISE, B_SHOULDER_HALF, B_LEG_HALF, B_HEAD_RISE, B_TRUNK_TOP = range(6)
-B_R_LEG, B_R_TRUNK, B_R_HEAD, B_R_ARM, B_ARM_LEN, B_BODY_RADIUS, B_WALK_SPEED = range(6, 13)
-N_BODY_PARAMS = 13
+# The body parameter vector the compiled simulator poses the worker from (``BodyDimensions.params``).
+BODY_PARAMS = VectorSpec("body parameters", (
+    ("HIP_Z", "hip height above the floor [m]: the legs' top and the trunk's pivot"),
+    ("SHOULDER_RISE", "shoulder joints above the hip, along the trunk [m]"),
+    ("SHOULDER_HALF", "shoulder joint to the trunk's axis, sideways [m]"),
+    ("LEG_HALF", "leg axis to the body's centre line, sideways [m]"),
+    ("HEAD_RISE", "head centre above the hip, along the trunk [m]"),
+    ("TRUNK_TOP", "top of the trunk capsule's axis above the hip [m]"),
+    ("R_LEG", "leg capsule radius [m]"),
+    ("R_TRUNK", "trunk capsule radius [m]"),
+    ("R_HEAD", "head sphere radius [m]"),
+    ("R_ARM", "hanging-arm capsule radius [m]"),
+    ("ARM_LEN", "upper arm + forearm + hand [m]: the reach volumes lie within it of the shoulder"),
+    ("BODY_RADIUS", "footprint radius kept clear of fences and table edges [m]"),
+    ("WALK_SPEED", "walking speed [m/s]"),
+))
+(B_HIP_Z, B_SHOULDER_RISE, B_SHOULDER_HALF, B_LEG_HALF, B_HEAD_RISE, B_TRUNK_TOP, B_R_LEG, B_R_TRUNK, B_R_HEAD,
+ B_R_ARM, B_ARM_LEN, B_BODY_RADIUS, B_WALK_SPEED) = BODY_PARAMS.indices(
+    "HIP_Z", "SHOULDER_RISE", "SHOULDER_HALF", "LEG_HALF", "HEAD_RISE", "TRUNK_TOP", "R_LEG", "R_TRUNK", "R_HEAD",
+    "R_ARM", "ARM_LEN", "BODY_RADIUS", "WALK_SPEED")
+N_BODY_PARAMS = BODY_PARAMS.size
 
 
 @dataclass(frozen=True)

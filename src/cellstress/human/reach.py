@@ -117,6 +117,42 @@ def _joint_samples(step_deg: tuple[float, float, float, float, float]) -> np.nda
     return np.stack([m.ravel() for m in mesh], axis=1)
 
 
+# The lookup the simulator's kernels inline into their hot loop (and ReachField.distance calls): it is the
+# field's own interpolation, so it lives with the field.
+@njit(cache=True, error_model="numpy", inline="always")
+def _grid_coord(c, origin, hi, h, n):
+    """(clamped cell index, fraction, squared distance outside the grid) along one axis."""
+    out2 = 0.0
+    if c < origin:
+        out2 = (origin - c) ** 2
+        c = origin
+    elif c > hi:
+        out2 = (c - hi) ** 2
+        c = hi
+    g = (c - origin) / h
+    i = int(g)
+    if i > n - 2:
+        i = n - 2
+    return i, g - i, out2
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def reach_lookup(vals, origin, h, px, py, pz):
+    """Trilinear signed distance at p (shoulder frame); beyond the grid, the distance to it is added."""
+    n = vals.shape[0]
+    hi = origin + (n - 1) * h
+    i, fx, ex = _grid_coord(px, origin, hi, h, n)
+    j, fy, ey = _grid_coord(py, origin, hi, h, n)
+    k, fz, ez = _grid_coord(pz, origin, hi, h, n)
+    c00 = vals[i, j, k] * (1 - fx) + vals[i + 1, j, k] * fx
+    c10 = vals[i, j + 1, k] * (1 - fx) + vals[i + 1, j + 1, k] * fx
+    c01 = vals[i, j, k + 1] * (1 - fx) + vals[i + 1, j, k + 1] * fx
+    c11 = vals[i, j + 1, k + 1] * (1 - fx) + vals[i + 1, j + 1, k + 1] * fx
+    c0 = c00 * (1 - fy) + c10 * fy
+    c1 = c01 * (1 - fy) + c11 * fy
+    return c0 * (1 - fz) + c1 * fz + np.sqrt(ex + ey + ez)
+
+
 @dataclass(frozen=True)
 class ReachField:
     """Signed distance [m] to the arm's reachable workspace, on a cube grid in the shoulder frame."""
@@ -132,8 +168,6 @@ class ReachField:
 
     def distance(self, points: np.ndarray) -> np.ndarray:
         """Trilinear lookup for points (m, 3) in the right shoulder frame (reference, not the hot path)."""
-        from cellstress.sim.kernels import reach_lookup
-
         return np.array([reach_lookup(self.values, self.origin, self.spacing, *(float(c) for c in p)) for p in points])
 
 

@@ -161,7 +161,7 @@ def draw_plan(ax, layout: Layout, style: PlanStyle = PlanStyle(), robot_tau: flo
               zone=None, robot_when: str = "at contact") -> list:
     """Draw the cell to scale in metres; returns legend handles (one per kind of thing shown). The robot is
     drawn at path time ``robot_tau`` (labelled ``robot_when``), or at t = 0 without one."""
-    from cellstress.sim import kernels as K
+    from cellstress.sim import layout as L
     from cellstress.sim import scene
 
     spec = layout.cell.spec
@@ -191,7 +191,7 @@ def draw_plan(ax, layout: Layout, style: PlanStyle = PlanStyle(), robot_tau: flo
     ax.plot([base[0]], [base[1]], marker="P", ms=9, color=ROBOT, mec="white", zorder=7, ls="none")
     handles.append(Line2D([], [], marker="P", ms=9, color=ROBOT, mec="white", ls="none", label="robot base"))
     if style.robot_now:
-        tau = float(layout.params.scal[K.C_PHASE0]) if robot_tau is None else robot_tau  # the pose at t = 0
+        tau = float(layout.params.scal[L.C_PHASE0]) if robot_tau is None else robot_tau  # the pose at t = 0
         a, b = scene.robot_capsules(layout, tau)
         ax.add_collection(capsule_patches(a[:, :2], b[:, :2], layout.params.cap_r, facecolor=ROBOT, alpha=0.55,
                                           edgecolor="white", lw=0.5, zorder=6))

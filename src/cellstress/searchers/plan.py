@@ -60,7 +60,7 @@ import numpy as np
 from cellstress.core.protocols import WorkerModel
 from cellstress.searchers.common import Recorder, SearchError, number, whole
 from cellstress.searchers.evolve import REDRAWS
-from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 
 PLAN_KEY = 9
 POINT_GRID = 0.02  # robot points closer than this (per coordinate, rounded) are kept as one, with the least offset
@@ -128,7 +128,7 @@ class Plan:
                     break
             rows = np.concatenate(rows)
             model.learn(played, rows)
-            running = rows[rows[:, K.M_PHASE] == K.PHASE_RUNNING, K.M_D]
+            running = rows[rows[:, L.M_PHASE] == L.PHASE_RUNNING, L.M_D]
             closest[tuple(played)] = float(running.min()) if len(running) else math.inf
             rec.finish(played, ret, risk, unsafe)  # raises Stop at the end
 
@@ -170,8 +170,8 @@ class _Model:
         self.sim = sim
         self.spa, self.horizon = sim.steps_per_action, sim.actions_per_episode
         self.n_steps = self.horizon * self.spa
-        self.v_tol = float(sim.params.scal[K.C_VTOL])
-        self.pose_cols = [K.M_X, K.M_Y, K.M_HEADING, K.M_FWD, K.M_LAT]
+        self.v_tol = float(sim.params.scal[L.C_VTOL])
+        self.pose_cols = [L.M_X, L.M_Y, L.M_HEADING, L.M_FWD, L.M_LAT]
         self.points: list[dict] = [{} for _ in range(self.n_steps + 1)]  # step -> {cell: (point, offset)}
         self.speed = np.full(self.n_steps + 1, np.nan)  # v_R on the programmed path, per step (1-based)
         self.delays: dict[int, list[tuple[int, int]]] = {}  # device mask -> [(to braking, to standstill)]
@@ -187,23 +187,23 @@ class _Model:
                                 wh * np.sin(poses[:, 2]), wf * poses[:, 3], wf * poses[:, 4]])
 
     def learn(self, actions: list[int], rows: np.ndarray) -> None:
-        seen = rows[:, K.M_SEEN].astype(np.int64)
-        braking = np.flatnonzero(rows[:, K.M_PHASE] >= K.PHASE_BRAKING)
-        stopped = np.flatnonzero(rows[:, K.M_PHASE] >= K.PHASE_STOPPED)
+        seen = rows[:, L.M_SEEN].astype(np.int64)
+        braking = np.flatnonzero(rows[:, L.M_PHASE] >= L.PHASE_BRAKING)
+        stopped = np.flatnonzero(rows[:, L.M_PHASE] >= L.PHASE_STOPPED)
         for p in range(1, len(actions) + 1):
             n = min(p * self.spa, len(rows))
             b = int(braking[0]) if len(braking) and braking[0] < n else -1
             s = int(stopped[0]) if len(stopped) and stopped[0] < n else -1
             self.prefixes[tuple(actions[:p])] = (n, seen[:n], b, s)
-        on_path = rows[rows[:, K.M_PHASE] <= K.PHASE_PENDING]
+        on_path = rows[rows[:, L.M_PHASE] <= L.PHASE_PENDING]
         if len(on_path):
-            pts = on_path[:, [K.M_RX, K.M_RY, K.M_RZ]]
+            pts = on_path[:, [L.M_RX, L.M_RY, L.M_RZ]]
             reach = self.sim.worker_distances(on_path[:, self.pose_cols], pts[:, None, :])[:, 0]
             for row, point, dist in zip(on_path, pts, reach, strict=True):
-                k = int(row[K.M_STEP])
-                self.speed[k] = row[K.M_V]
+                k = int(row[L.M_STEP])
+                self.speed[k] = row[L.M_V]
                 cell = tuple(np.round(point / POINT_GRID).astype(int))
-                offset = float(dist - row[K.M_D])
+                offset = float(dist - row[L.M_D])
                 old = self.points[k].get(cell)
                 if old is None or offset < old[1]:
                     self.points[k][cell] = (point, offset)

@@ -16,8 +16,9 @@ from cellstress.robot.capsules import Capsule, declared_capsule, fitted_capsules
 from cellstress.robot.model import RobotModel, load_robot, resolve_urdf
 from cellstress.robot.trajectory import Trajectory, build_trajectory
 from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 
-SCANNER, CURTAIN = K.DEV_SCANNER, K.DEV_CURTAIN  # detection primitive kinds in the kernel
+SCANNER, CURTAIN = L.DEV_SCANNER, L.DEV_CURTAIN  # detection primitive kinds in the kernel
 
 
 @dataclass(frozen=True)
@@ -115,18 +116,18 @@ def build_layout(cell: Cell) -> Layout:
 
     dev = device_arrays(spec.devices)
 
-    scal = np.zeros(K.N_SCAL)
-    scal[K.C_DT] = spec.simulation.dt
-    scal[K.C_STOP_TIME] = spec.robot.stopping_time
-    scal[K.C_PHASE0] = task.phase
-    scal[K.C_CYCLE] = traj.cycle
-    scal[K.C_DWELL] = traj.dwell
+    scal = np.zeros(L.N_SCAL)
+    scal[L.C_DT] = spec.simulation.dt
+    scal[L.C_STOP_TIME] = spec.robot.stopping_time
+    scal[L.C_PHASE0] = task.phase
+    scal[L.C_CYCLE] = traj.cycle
+    scal[L.C_DWELL] = traj.dwell
     # a criterion without a kernel fast path: the kernel latches no contact (it may be safe), the Simulator judges
     fast = spec.criterion.kernel_test()
-    scal[K.C_DTOL] = spec.criterion.distance_tolerance if fast is None else fast.distance_tolerance
-    scal[K.C_VTOL] = np.inf if fast is None else fast.speed_tolerance
-    scal[K.C_REACH_ORIGIN] = reach.origin
-    scal[K.C_REACH_H] = reach.spacing
+    scal[L.C_DTOL] = spec.criterion.distance_tolerance if fast is None else fast.distance_tolerance
+    scal[L.C_VTOL] = np.inf if fast is None else fast.speed_tolerance
+    scal[L.C_REACH_ORIGIN] = reach.origin
+    scal[L.C_REACH_H] = reach.spacing
 
     params = K.SimParams(
         scal=scal,
@@ -177,10 +178,10 @@ def _with_robot_table(params: K.SimParams, spec) -> K.SimParams:
 def with_phase(layout: Layout, phase: float) -> Layout:
     """The same cell with the robot's cycle at ``phase`` s when an episode starts (a start point's own
     ``phase``): only the phase scalar and the robot table of the steps before any stop change."""
-    if float(phase) == float(layout.params.scal[K.C_PHASE0]):
+    if float(phase) == float(layout.params.scal[L.C_PHASE0]):
         return layout
     scal = layout.params.scal.copy()
-    scal[K.C_PHASE0] = float(phase)
+    scal[L.C_PHASE0] = float(phase)
     nc = layout.params.cap_r.shape[0]
     bare = layout.params._replace(scal=scal, pre_ra=np.zeros((0, nc, 3)), pre_rb=np.zeros((0, nc, 3)),
                                   pre_v=np.zeros(0), pre_tau=np.zeros(0))  # as build_layout computes it

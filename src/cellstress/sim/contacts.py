@@ -18,7 +18,7 @@ from cellstress.human.body import BODY_PARTS
 from cellstress.human.regions import body_region
 from cellstress.robot.dynamics import point_dynamics, reflected_mass
 from cellstress.robot.model import load_pinocchio
-from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim import scene
 from cellstress.sim.build import Layout
 
@@ -37,10 +37,10 @@ class ContactModel:
     def contact(self, row: np.ndarray) -> Contact:
         """The closest points of a metric row, with the region, normal, v_rel and reflected mass there."""
         lay, P = self.layout, self.layout.params
-        link, part = int(row[K.M_LINK]), int(row[K.M_PART])
-        rp = np.array(row[K.M_RX:K.M_RZ + 1], dtype=float)
-        hp = np.array(row[K.M_HX:K.M_HZ + 1], dtype=float)
-        pose = scene.body_pose(lay, row[K.M_X], row[K.M_Y], row[K.M_HEADING], row[K.M_FWD], row[K.M_LAT])
+        link, part = int(row[L.M_LINK]), int(row[L.M_PART])
+        rp = np.array(row[L.M_RX:L.M_RZ + 1], dtype=float)
+        hp = np.array(row[L.M_HX:L.M_HZ + 1], dtype=float)
+        pose = scene.body_pose(lay, row[L.M_X], row[L.M_Y], row[L.M_HEADING], row[L.M_FWD], row[L.M_LAT])
         q, qd = scene.joint_state(lay, row)
         n = scene.contact_normal(lay, row, pose)
         b = lay.body
@@ -54,6 +54,6 @@ class ContactModel:
             Jp, M = point_dynamics(self.model, self.data, q, j + 1, pb)
             m_r = reflected_mass(Jp, M, nb)
             v_rel = max(0.0, float(nb @ (Jp @ qd)))
-        return Contact(float(row[K.M_D]), float(row[K.M_V]), lay.capsules[link].name, BODY_PARTS[part], region,
+        return Contact(float(row[L.M_D]), float(row[L.M_V]), lay.capsules[link].name, BODY_PARTS[part], region,
                        (float(rp[0]), float(rp[1]), float(rp[2])), (float(hp[0]), float(hp[1]), float(hp[2])),
                        (float(n[0]), float(n[1]), float(n[2])), v_rel, m_r)

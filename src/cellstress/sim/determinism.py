@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from cellstress.human.actions import action_index
-from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
 
 
@@ -53,7 +53,7 @@ def check_determinism(sim: Simulator, sequences, repeats: int = 2) -> int:
         spa = sim.steps_per_action
         for n, seq in enumerate(same_len):
             rows = sim.run(seq).rows
-            last = int(rows[-1, K.M_STEP])
+            last = int(rows[-1, L.M_STEP])
             played = -(-last // spa)  # actions that were (at least partly) played
             for k in range(len(seq)):
                 if k >= played:
@@ -61,11 +61,11 @@ def check_determinism(sim: Simulator, sequences, repeats: int = 2) -> int:
                         raise DeterminismError(f"batch episode {n}, action {k}: played after the episode ended")
                     continue
                 i = min((k + 1) * spa, last)  # row index = time step (row 0 is the initial state)
-                if not (_same_bits(np.array([batch.d_end[n, k]]), rows[i:i + 1, K.M_D])
-                        and _same_bits(np.array([batch.v_end[n, k]]), rows[i:i + 1, K.M_V])):
+                if not (_same_bits(np.array([batch.d_end[n, k]]), rows[i:i + 1, L.M_D])
+                        and _same_bits(np.array([batch.v_end[n, k]]), rows[i:i + 1, L.M_V])):
                     raise DeterminismError(f"batch episode {n}, action {k}: differs from run()")
-            unsafe_row = rows[-1, K.M_UNSAFE] != 0.0
-            expect = int(rows[-1, K.M_STEP]) if unsafe_row else -1
+            unsafe_row = rows[-1, L.M_UNSAFE] != 0.0
+            expect = int(rows[-1, L.M_STEP]) if unsafe_row else -1
             if int(batch.unsafe_step[n]) != expect:
                 raise DeterminismError(f"batch episode {n}: unsafe step {batch.unsafe_step[n]} != {expect}")
     return len(seqs)

@@ -1,43 +1,112 @@
-"""The state vector and the metric row of the cell simulator (placeholder: the names, from the kernels)."""
+"""The cell simulator's flat vectors, described once: the state, the metric row, the scalar parameters, the
+stop phases, the device kinds and the body parts the kernels know, and (from ``human.body``) the body
+parameters.
 
-from cellstress.sim.kernels import (  # noqa: F401
-    M_ACTION,
-    M_D,
-    M_FWD,
-    M_HEADING,
-    M_HX,
-    M_HY,
-    M_HZ,
-    M_LAT,
-    M_LINK,
-    M_PART,
-    M_PHASE,
-    M_RX,
-    M_RY,
-    M_RZ,
-    M_SEEN,
-    M_STEP,
-    M_T,
-    M_TAU,
-    M_UNSAFE,
-    M_V,
-    M_X,
-    M_Y,
-    NM,
-    NS,
-    PHASE_BRAKING,
-    PHASE_PENDING,
-    PHASE_RUNNING,
-    PHASE_STOPPED,
-    S_ACTIONS,
-    S_FWD,
-    S_HEADING,
-    S_K,
-    S_LAT,
-    S_TRIG_DEV,
-    S_TRIG_T,
-    S_TSTOP,
-    S_UNSAFE,
-    S_X,
-    S_Y,
+Each is a ``VectorSpec`` (names in order, a line of meaning each); the integer constants the compiled kernels
+index with (``S_X``, ``M_D``, ``C_DT``, ...) are taken from it by name, as plain module globals because numba
+reads globals as compile-time constants. Code outside the kernels reads these names here, never from the
+kernels, so where a slot lives is decided in this file alone.
+"""
+
+from __future__ import annotations
+
+from cellstress.core.vector_spec import VectorSpec
+from cellstress.human.body import (  # noqa: F401  (re-exported: the kernels and their callers read them here)
+    B_ARM_LEN,
+    B_BODY_RADIUS,
+    B_HEAD_RISE,
+    B_HIP_Z,
+    B_LEG_HALF,
+    B_R_ARM,
+    B_R_HEAD,
+    B_R_LEG,
+    B_R_TRUNK,
+    B_SHOULDER_HALF,
+    B_SHOULDER_RISE,
+    B_TRUNK_TOP,
+    B_WALK_SPEED,
+    BODY_PARAMS,
+    BODY_PARTS,
+    N_BODY_PARAMS,
+    N_CAPSULES,
 )
+
+STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
+    ("K", "time step k (a float): the state's time is k * dt"),
+    ("X", "worker's position on the floor, x [m]"),
+    ("Y", "worker's position on the floor, y [m]"),
+    ("HEADING", "worker's heading [rad], counter-clockwise from +x"),
+    ("FWD", "trunk forward flexion [rad]"),
+    ("LAT", "trunk lateral flexion [rad]"),
+    ("TSTOP", "time the robot's latched stop takes effect [s]; inf: none latched"),
+    ("TRIG_DEV", "device whose detection set TSTOP; -1: none"),
+    ("TRIG_T", "time of the first detection [s]; -1: none"),
+    ("UNSAFE", "1 once a step was unsafe: the episode has ended and the state no longer moves"),
+    ("ACTIONS", "actions played so far"),
+))
+S_K, S_X, S_Y, S_HEADING, S_FWD, S_LAT, S_TSTOP, S_TRIG_DEV, S_TRIG_T, S_UNSAFE, S_ACTIONS = STATE.indices(
+    "K", "X", "Y", "HEADING", "FWD", "LAT", "TSTOP", "TRIG_DEV", "TRIG_T", "UNSAFE", "ACTIONS")
+NS = STATE.size
+
+ROW = VectorSpec("metric row (one per time step; row 0 of an episode is its start)", (
+    ("T", "time [s]"),
+    ("X", "worker's position, x [m]"),
+    ("Y", "worker's position, y [m]"),
+    ("HEADING", "worker's heading [rad]"),
+    ("FWD", "trunk forward flexion [rad]"),
+    ("LAT", "trunk lateral flexion [rad]"),
+    ("D", "d_HR: least distance between robot and worker (body capsules or reach volumes), 0 in contact [m]"),
+    ("V", "v_R: the fastest robot joint origin's speed [m/s]"),
+    ("SEEN", "bit d set: device d sees the worker"),
+    ("PHASE", "robot's stop phase (PHASE)"),
+    ("LINK", "robot capsule nearest the worker; -1: none"),
+    ("PART", "worker's part nearest the robot, an index into BODY_PARTS; -1: none"),
+    ("RX", "nearest point on the robot, x [m] (RX, RY, RZ are consecutive)"),
+    ("RY", "nearest point on the robot, y [m]"),
+    ("RZ", "nearest point on the robot, z [m]"),
+    ("HX", "nearest point on the worker, x [m] (HX, HY, HZ are consecutive)"),
+    ("HY", "nearest point on the worker, y [m]"),
+    ("HZ", "nearest point on the worker, z [m]"),
+    ("UNSAFE", "1 where the criterion's kernel test holds (d_HR <= DTOL while v_R > VTOL)"),
+    ("TAU", "robot's path time [s]"),
+    ("ACTION", "action played; -1 in an episode's first row"),
+    ("STEP", "time step k"),
+))
+(M_T, M_X, M_Y, M_HEADING, M_FWD, M_LAT, M_D, M_V, M_SEEN, M_PHASE, M_LINK, M_PART, M_RX, M_RY, M_RZ, M_HX, M_HY, M_HZ,
+ M_UNSAFE, M_TAU, M_ACTION, M_STEP) = ROW.indices(
+    "T", "X", "Y", "HEADING", "FWD", "LAT", "D", "V", "SEEN", "PHASE", "LINK", "PART", "RX", "RY", "RZ", "HX", "HY",
+    "HZ", "UNSAFE", "TAU", "ACTION", "STEP")
+NM = ROW.size
+
+PHASE = VectorSpec("robot stop phase (values of the row's PHASE; records.STOP_PHASES names them in files)", (
+    ("RUNNING", "no stop latched"),
+    ("PENDING", "a stop is latched and takes effect later (the device's response time)"),
+    ("BRAKING", "slowing linearly to a standstill within the stopping time"),
+    ("STOPPED", "standing"),
+))
+PHASE_RUNNING, PHASE_PENDING, PHASE_BRAKING, PHASE_STOPPED = PHASE.indices("RUNNING", "PENDING", "BRAKING", "STOPPED")
+
+SCALARS = VectorSpec("scalar parameters (SimParams.scal)", (
+    ("DT", "time step [s]"),
+    ("STOP_TIME", "robot's stopping time: from full speed to standstill [s]"),
+    ("PHASE0", "robot's path time when an episode starts [s]"),
+    ("CYCLE", "robot's cycle time [s]"),
+    ("DWELL", "robot's dwell at each waypoint [s]"),
+    ("DTOL", "contact distance of the criterion's kernel test [m]"),
+    ("VTOL", "robot speed above which a contact is unsafe [m/s]; inf: the kernel judges no contact"),
+    ("REACH_ORIGIN", "reach field: coordinate of its first grid node on every axis [m]"),
+    ("REACH_H", "reach field: grid spacing [m]"),
+))
+(C_DT, C_STOP_TIME, C_PHASE0, C_CYCLE, C_DWELL, C_DTOL, C_VTOL, C_REACH_ORIGIN, C_REACH_H) = SCALARS.indices(
+    "DT", "STOP_TIME", "PHASE0", "CYCLE", "DWELL", "DTOL", "VTOL", "REACH_ORIGIN", "REACH_H")
+N_SCAL = SCALARS.size
+
+DEVICE_KINDS = VectorSpec("detection primitive kinds (SimParams.dev_kind)", (
+    ("SCANNER", "horizontal scan plane over a polygon (dev_poly, dev_verts; its height in dev_rect[4])"),
+    ("CURTAIN", "vertical rectangle (dev_rect: x0 y0 x1 y1 bottom top)"),
+))
+DEV_SCANNER, DEV_CURTAIN = DEVICE_KINDS.indices("SCANNER", "CURTAIN")
+
+# The worker's parts in the row's PART: the body capsules, then the two reach volumes.
+N_BODY_CAPSULES = N_CAPSULES
+PART_LEFT_REACH, PART_RIGHT_REACH = BODY_PARTS.index("left-reach"), BODY_PARTS.index("right-reach")

@@ -24,7 +24,7 @@ It is a *score* for searchers, not part of the simulation: the episode, its metr
 unchanged, and no episode is played. The extra work is (horizon / dt + 1) robot poses and separations per time
 step (5 for the default 0.2 s at 50 ms), done by the same compiled functions as the simulator's
 (``kernels.robot_live``, ``kernels.human_pose``, ``kernels.near_fences``, ``kernels.separation``) on a Work of
-its own; ``kernels.py`` is not changed.
+its own; the kernels are not changed.
 
 Why it helps: a closeness score measured at the same instant cannot tell a worker who stands at a light
 curtain while the robot dwells from one who stands there just before the arm moves on (docs/results.md, S2).
@@ -37,6 +37,7 @@ import numpy as np
 from numba import njit
 
 from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 
 
 @njit(cache=True, error_model="numpy")
@@ -48,16 +49,16 @@ def lookahead_gaps(P, W, rows, t_stop, horizon, speed, n_tau, out):
     requested by then). The window [t_k, t_k + horizon] is sampled at n_tau + 1 equally spaced times.
     """
     scal = P.scal
-    vtol = scal[K.C_VTOL]
+    vtol = scal[L.C_VTOL]
     if not vtol < np.inf:  # a criterion without a speed tolerance (iso15066): any motion counts
         vtol = 0.0
-    arm_len = P.body[K.B_ARM_LEN]
-    origin, grid_h = scal[K.C_REACH_ORIGIN], scal[K.C_REACH_H]
-    scratch = np.zeros(K.NM)
+    arm_len = P.body[L.B_ARM_LEN]
+    origin, grid_h = scal[L.C_REACH_ORIGIN], scal[L.C_REACH_H]
+    scratch = np.zeros(L.NM)
     for i in range(rows.shape[0]):
-        t0 = rows[i, K.M_T]
-        ts = np.inf if rows[i, K.M_PHASE] == K.PHASE_RUNNING else t_stop
-        K.human_pose(P, rows[i, K.M_X], rows[i, K.M_Y], rows[i, K.M_HEADING], rows[i, K.M_FWD], rows[i, K.M_LAT],
+        t0 = rows[i, L.M_T]
+        ts = np.inf if rows[i, L.M_PHASE] == L.PHASE_RUNNING else t_stop
+        K.human_pose(P, rows[i, L.M_X], rows[i, L.M_Y], rows[i, L.M_HEADING], rows[i, L.M_FWD], rows[i, L.M_LAT],
                      W)
         n_near = K.near_fences(P, W, arm_len + 0.05)  # as sense_and_measure collects them
         best = np.inf
@@ -78,7 +79,7 @@ def default_horizon(params) -> float:
     """T of ISO 13855 for the fastest device: its response time plus the robot's stopping time [s], the
     shortest time for which the robot moves on after a worker is first seen."""
     resp = float(np.min(params.dev_resp)) if params.dev_resp.size else 0.0
-    return resp + float(params.scal[K.C_STOP_TIME])
+    return resp + float(params.scal[L.C_STOP_TIME])
 
 
 class Lookahead:
@@ -94,7 +95,7 @@ class Lookahead:
         if not self.horizon >= 0.0 or not speed >= 0.0:
             raise ValueError("horizon and speed must be >= 0")
         self.speed = float(speed)
-        dt = float(params.scal[K.C_DT]) if step is None else float(step)
+        dt = float(params.scal[L.C_DT]) if step is None else float(step)
         self.n_tau = max(0, int(round(self.horizon / dt)))
         self._work = K.make_work(params)
 

@@ -12,6 +12,7 @@ from numba import njit
 
 from cellstress.human.body import N_CAPSULES, BodyPose
 from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.build import Layout
 from cellstress.sim.geometry import segment_segment
 
@@ -30,13 +31,13 @@ def robot_capsules(layout: Layout, tau: float) -> tuple[np.ndarray, np.ndarray]:
     the pose is ``kernels.robot_live`` at t = tau - phase with no stop."""
     P = layout.params
     W = K.make_work(P)
-    K.robot_live(P, float(tau) - float(P.scal[K.C_PHASE0]), np.inf, W)
+    K.robot_live(P, float(tau) - float(P.scal[L.C_PHASE0]), np.inf, W)
     return W.ra.copy(), W.rb.copy()
 
 
 def path_times(rows: np.ndarray) -> np.ndarray:
     """The robot's path time at every row of ``Trace.rows``."""
-    return np.asarray(rows[:, K.M_TAU], dtype=float)
+    return np.asarray(rows[:, L.M_TAU], dtype=float)
 
 
 @njit(cache=True, error_model="numpy")
@@ -68,12 +69,12 @@ def reach_points(layout: Layout, pose: BodyPose, side: int, stride: int = 1,
     pts = pose.shoulders[side] + local @ pose.trunk.T
     W = K.make_work(P)
     W.sh[:] = pose.shoulders
-    n_near = int(K.near_fences(P, W, P.body[K.B_ARM_LEN] + 0.05))
+    n_near = int(K.near_fences(P, W, P.body[L.B_ARM_LEN] + 0.05))
     if n_near == 0:
         return pts
     keep = np.zeros(len(pts), dtype=np.bool_)
     _detour_within(P.fences, W.near, n_near, np.ascontiguousarray(pose.shoulders[side]), np.ascontiguousarray(pts),
-                   float(P.body[K.B_ARM_LEN]), keep)
+                   float(P.body[L.B_ARM_LEN]), keep)
     return pts[keep]
 
 
@@ -83,12 +84,12 @@ def joint_state(layout: Layout, row: np.ndarray) -> tuple[np.ndarray, np.ndarray
     The row holds the path time tau and the stop phase; while braking, the time since the stop took effect
     follows from tau = tau0 + t_s + d - d^2 / (2 T) with t = t_s + d, so the time-scaling sigma = 1 - d / T."""
     P = layout.params
-    T = float(P.scal[K.C_STOP_TIME])
-    tau, t, phase = float(row[K.M_TAU]), float(row[K.M_T]), int(row[K.M_PHASE])
-    if phase == K.PHASE_STOPPED:
+    T = float(P.scal[L.C_STOP_TIME])
+    tau, t, phase = float(row[L.M_TAU]), float(row[L.M_T]), int(row[L.M_PHASE])
+    if phase == L.PHASE_STOPPED:
         sigma = 0.0
-    elif phase == K.PHASE_BRAKING:
-        d = float(np.sqrt(max(0.0, 2.0 * T * (t + float(P.scal[K.C_PHASE0]) - tau))))
+    elif phase == L.PHASE_BRAKING:
+        d = float(np.sqrt(max(0.0, 2.0 * T * (t + float(P.scal[L.C_PHASE0]) - tau))))
         sigma = max(0.0, 1.0 - d / T)
     else:
         sigma = 1.0
@@ -102,17 +103,17 @@ def contact_normal(layout: Layout, row: np.ndarray, pose: BodyPose) -> np.ndarra
     """Unit normal from the robot towards the human at a row's closest points: between the capsule axes for a
     body capsule (defined also when they overlap), from the robot point towards the shoulder for a reach volume
     (as the kernel places the points)."""
-    part, link = int(row[K.M_PART]), int(row[K.M_LINK])
-    rp = np.asarray(row[K.M_RX:K.M_RZ + 1], dtype=float)
+    part, link = int(row[L.M_PART]), int(row[L.M_LINK])
+    rp = np.asarray(row[L.M_RX:L.M_RZ + 1], dtype=float)
     if part >= N_CAPSULES:
         v = pose.shoulders[part - N_CAPSULES] - rp
     else:
-        ra, rb = robot_capsules(layout, float(row[K.M_TAU]))
+        ra, rb = robot_capsules(layout, float(row[L.M_TAU]))
         c1, c2 = np.zeros(3), np.zeros(3)
         segment_segment(np.ascontiguousarray(ra[link]), np.ascontiguousarray(rb[link]),
                           np.ascontiguousarray(pose.a[part]), np.ascontiguousarray(pose.b[part]), c1, c2)
         v = c2 - c1
         if float(np.linalg.norm(v)) <= 1e-9:
-            v = np.asarray(row[K.M_HX:K.M_HZ + 1], dtype=float) - rp
+            v = np.asarray(row[L.M_HX:L.M_HZ + 1], dtype=float) - rp
     n = float(np.linalg.norm(v))
     return v / n if n > 1e-12 else np.array([0.0, 0.0, 1.0])

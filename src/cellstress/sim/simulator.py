@@ -22,6 +22,7 @@ from cellstress.core.records import Measures
 from cellstress.human.actions import ACTION_NAMES, N_ACTIONS, action_index
 from cellstress.human.body import BODY_PARTS
 from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
 from cellstress.sim.build import Layout, build_layout, with_phase
 from cellstress.sim.contacts import ContactModel
 from cellstress.sim.lookahead import Lookahead
@@ -31,7 +32,7 @@ from cellstress.sim.starts import START_PREFIX, split_start
 
 @dataclass(frozen=True)
 class Trace:
-    """Per-step metrics of an episode: ``rows[i]`` follows kernels.M_*; row 0 is the initial state."""
+    """Per-step metrics of an episode: ``rows[i]`` is laid out as ``sim.layout.ROW``; row 0 is the initial state."""
 
     rows: np.ndarray
     actions: tuple[int, ...]
@@ -39,11 +40,11 @@ class Trace:
 
     @property
     def unsafe(self) -> bool:
-        return bool(self.rows[-1, K.M_UNSAFE])
+        return bool(self.rows[-1, L.M_UNSAFE])
 
     @property
     def unsafe_row(self) -> int | None:
-        hits = np.flatnonzero(self.rows[:, K.M_UNSAFE])
+        hits = np.flatnonzero(self.rows[:, L.M_UNSAFE])
         return int(hits[0]) if hits.size else None
 
     def record(self, i: int) -> StepRecord:
@@ -55,28 +56,28 @@ class Trace:
 
 def step_record(row: np.ndarray, layout: Layout) -> StepRecord:
     """One metric row as a named record (made without validation: the row is the simulator's own)."""
-    seen = int(row[K.M_SEEN])
-    link = int(row[K.M_LINK])
-    part = int(row[K.M_PART])
-    act = int(row[K.M_ACTION])
+    seen = int(row[L.M_SEEN])
+    link = int(row[L.M_LINK])
+    part = int(row[L.M_PART])
+    act = int(row[L.M_ACTION])
     return StepRecord.model_construct(
-        step=int(row[K.M_STEP]),
-        t=round(float(row[K.M_T]), 9),  # k * dt carries float noise (0.6000000000000001)
+        step=int(row[L.M_STEP]),
+        t=round(float(row[L.M_T]), 9),  # k * dt carries float noise (0.6000000000000001)
         action=ACTION_NAMES[act] if act >= 0 else None,
-        x=float(row[K.M_X]),
-        y=float(row[K.M_Y]),
-        heading_deg=float(np.rad2deg(row[K.M_HEADING])),
-        forward_flexion_deg=float(np.rad2deg(row[K.M_FWD])),
-        lateral_flexion_deg=float(np.rad2deg(row[K.M_LAT])),
-        d_HR=float(row[K.M_D]),
-        v_R=float(row[K.M_V]),
+        x=float(row[L.M_X]),
+        y=float(row[L.M_Y]),
+        heading_deg=float(np.rad2deg(row[L.M_HEADING])),
+        forward_flexion_deg=float(np.rad2deg(row[L.M_FWD])),
+        lateral_flexion_deg=float(np.rad2deg(row[L.M_LAT])),
+        d_HR=float(row[L.M_D]),
+        v_R=float(row[L.M_V]),
         devices=tuple(n for i, n in enumerate(layout.device_names) if seen >> i & 1),
-        stop_phase=STOP_PHASES[int(row[K.M_PHASE])],
+        stop_phase=STOP_PHASES[int(row[L.M_PHASE])],
         robot_link=layout.capsules[link].name if link >= 0 else None,
         body_part=BODY_PARTS[part] if part >= 0 else None,
-        robot_point=tuple(float(v) for v in row[K.M_RX:K.M_RZ + 1]),
-        human_point=tuple(float(v) for v in row[K.M_HX:K.M_HZ + 1]),
-        unsafe=bool(row[K.M_UNSAFE]),
+        robot_point=tuple(float(v) for v in row[L.M_RX:L.M_RZ + 1]),
+        human_point=tuple(float(v) for v in row[L.M_HX:L.M_HZ + 1]),
+        unsafe=bool(row[L.M_UNSAFE]),
     )
 
 
@@ -124,12 +125,12 @@ class Simulator:
             s = cell.spec.human.start
             start = (s.xy[0], s.xy[1], s.heading_deg)
         self.start = tuple(float(v) for v in start)
-        self._s0 = np.zeros(K.NS)
-        self._row0 = np.zeros(K.NM)
+        self._s0 = np.zeros(L.NS)
+        self._row0 = np.zeros(L.NM)
         K.reset_state(self.params, self.start[0], self.start[1], float(np.deg2rad(self.start[2])),
                       self._s0, self._work, self._row0)
         self._s0.setflags(write=False)
-        self._rows = np.zeros((self.params.spa, K.NM))
+        self._rows = np.zeros((self.params.spa, L.NM))
         self.criterion = cell.spec.criterion
         # a criterion without a kernel fast path judges the contacts here (sim.contacts)
         self.contacts = None if self.criterion.kernel_test() is not None else ContactModel(self.layout)
@@ -146,7 +147,7 @@ class Simulator:
     @property
     def phase(self) -> float:
         """The robot's path time at t = 0 (the cell's ``robot.task.phase`` or a start point's own)."""
-        return float(self.params.scal[K.C_PHASE0])
+        return float(self.params.scal[L.C_PHASE0])
 
     # ---- facts ------------------------------------------------------------------------------------------
     @property
@@ -167,7 +168,7 @@ class Simulator:
 
     @property
     def dt(self) -> float:
-        return float(self.params.scal[K.C_DT])
+        return float(self.params.scal[L.C_DT])
 
     # ---- stepping ---------------------------------------------------------------------------------------
     def reset(self) -> np.ndarray:
@@ -187,8 +188,8 @@ class Simulator:
             i = self.first_unsafe(rows)
             if i is not None:  # the criterion's unsafe step ends the episode there, as the kernel's would
                 rows = rows[:i + 1]
-                rows[i, K.M_UNSAFE] = 1.0
-                nxt[K.S_UNSAFE] = 1.0
+                rows[i, L.M_UNSAFE] = 1.0
+                nxt[L.S_UNSAFE] = 1.0
                 if i < n - 1:
                     _state_at(nxt, state, rows, self.params.dev_resp)
         return nxt, rows
@@ -198,9 +199,9 @@ class Simulator:
         returns the metric row of each one's last time step ((n, NM); NaN for a state that was already unsafe
         and does not move). The same as ``step`` on each."""
         acts = np.asarray(actions, dtype=np.int64).reshape(-1)
-        if states.ndim != 2 or states.shape != (len(acts), K.NS):
-            raise ValueError(f"states must be (n, {K.NS}) for n actions")
-        out = np.full((len(acts), K.NM), np.nan)
+        if states.ndim != 2 or states.shape != (len(acts), L.NS):
+            raise ValueError(f"states must be (n, {L.NS}) for n actions")
+        out = np.full((len(acts), L.NM), np.nan)
         for i, a in enumerate(acts):
             nxt, rows = self.step(states[i], int(a))
             states[i] = nxt
@@ -211,7 +212,7 @@ class Simulator:
     def first_unsafe(self, rows: np.ndarray) -> int | None:
         """Index of the first row the criterion judges unsafe (contacts only: they are rare)."""
         tol = self.criterion.distance_tolerance
-        for i in np.flatnonzero(rows[:, K.M_D] <= tol):
+        for i in np.flatnonzero(rows[:, L.M_D] <= tol):
             if self.criterion.judge(self.contacts.contact(rows[i])).unsafe:
                 return int(i)
         return None
@@ -225,17 +226,17 @@ class Simulator:
         """What the reward sees of an action: d_HR and v_R at its last step (and the criterion's severity there)."""
         last = rows[-1]
         if self.contacts is None:
-            return Measures(float(last[K.M_D]), float(last[K.M_V]))
-        return Measures(float(last[K.M_D]), float(last[K.M_V]),
+            return Measures(float(last[L.M_D]), float(last[L.M_V]))
+        return Measures(float(last[L.M_D]), float(last[L.M_V]),
                         float(self.criterion.severity(self.contacts.contact(last))))
 
     @staticmethod
     def is_unsafe(state: np.ndarray) -> bool:
-        return state[K.S_UNSAFE] != 0.0
+        return state[L.S_UNSAFE] != 0.0
 
     @staticmethod
     def time(state: np.ndarray) -> float:
-        return float(state[K.S_K])
+        return float(state[L.S_K])
 
     @staticmethod
     def snapshot(state: np.ndarray) -> bytes:
@@ -257,7 +258,7 @@ class Simulator:
         la = self._lookahead.get(key)
         if la is None:
             la = self._lookahead[key] = self.lookahead_model(horizon, speed)
-        return la.gaps(rows, state[K.S_TSTOP])
+        return la.gaps(rows, state[L.S_TSTOP])
 
     # ---- episodes ---------------------------------------------------------------------------------------
     def run(self, actions) -> Trace:
@@ -275,7 +276,7 @@ class Simulator:
                 if self.is_unsafe(state):
                     break
             return Trace(np.concatenate(parts), tuple(int(a) for a in acts), self.layout)
-        out = np.zeros((1 + len(acts) * self.params.spa, K.NM))
+        out = np.zeros((1 + len(acts) * self.params.spa, L.NM))
         n = K.run_episode(self.params, self._s0, acts, out)
         return Trace(out[:n], tuple(int(a) for a in acts), self.layout)
 
@@ -305,9 +306,9 @@ class Simulator:
                 state, rows = self.step(state, int(a))
                 m = self.measures(rows)
                 d_end[e, k], v_end[e, k], severity[e, k] = m.d_hr, m.v_r, m.severity
-                lo = min(lo, float(rows[:, K.M_D].min()))
+                lo = min(lo, float(rows[:, L.M_D].min()))
                 if self.is_unsafe(state):
-                    unsafe_step[e] = int(rows[-1, K.M_STEP])
+                    unsafe_step[e] = int(rows[-1, L.M_STEP])
                     break
             min_d[e] = lo
         return BatchResult(d_end, v_end, unsafe_step, min_d, self.params.spa, severity)
@@ -357,15 +358,15 @@ def _state_at(nxt: np.ndarray, before: np.ndarray, rows: np.ndarray, resp: np.nd
     ``rows[-1]``, where a criterion ended the episode: the clock and pose from that row, and the stop latch
     replayed from the devices each row saw, as ``kernels.sense_and_measure`` latches it."""
     row = rows[-1]
-    nxt[K.S_K] = row[K.M_STEP]
-    nxt[K.S_X], nxt[K.S_Y], nxt[K.S_HEADING] = row[K.M_X], row[K.M_Y], row[K.M_HEADING]
-    nxt[K.S_FWD], nxt[K.S_LAT] = row[K.M_FWD], row[K.M_LAT]
-    nxt[K.S_TSTOP], nxt[K.S_TRIG_DEV], nxt[K.S_TRIG_T] = before[K.S_TSTOP], before[K.S_TRIG_DEV], before[K.S_TRIG_T]
+    nxt[L.S_K] = row[L.M_STEP]
+    nxt[L.S_X], nxt[L.S_Y], nxt[L.S_HEADING] = row[L.M_X], row[L.M_Y], row[L.M_HEADING]
+    nxt[L.S_FWD], nxt[L.S_LAT] = row[L.M_FWD], row[L.M_LAT]
+    nxt[L.S_TSTOP], nxt[L.S_TRIG_DEV], nxt[L.S_TRIG_T] = before[L.S_TSTOP], before[L.S_TRIG_DEV], before[L.S_TRIG_T]
     for r in rows:
-        seen, t = int(r[K.M_SEEN]), r[K.M_T]
+        seen, t = int(r[L.M_SEEN]), r[L.M_T]
         for d in range(len(resp)):
-            if seen >> d & 1 and t + resp[d] < nxt[K.S_TSTOP]:
-                nxt[K.S_TSTOP] = t + resp[d]
-                if nxt[K.S_TRIG_DEV] < 0:
-                    nxt[K.S_TRIG_T] = t
-                nxt[K.S_TRIG_DEV] = d
+            if seen >> d & 1 and t + resp[d] < nxt[L.S_TSTOP]:
+                nxt[L.S_TSTOP] = t + resp[d]
+                if nxt[L.S_TRIG_DEV] < 0:
+                    nxt[L.S_TRIG_T] = t
+                nxt[L.S_TRIG_DEV] = d

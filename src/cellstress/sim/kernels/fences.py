@@ -1,0 +1,176 @@
+"""Fence panels in the hand's way: which panels are near, whether a straight path crosses one, and the
+shortest way round them (over the top edge or around an end) with a lower bound of it."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from cellstress.sim.geometry import NO_REFCOUNT, point_segment_2d
+
+
+@njit(cache=True, error_model="numpy")
+def near_fences(P, W, margin):
+    """Collect into W.near the fence panels within ``margin`` of either shoulder (plan view)."""
+    return collect_near_fences(P.fences, W.sh, W.near, margin)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def collect_near_fences(fences, sh, near, margin):
+    n = 0
+    for f in range(fences.shape[0]):
+        x0, y0, x1, y1 = fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3]
+        d0 = point_segment_2d(sh[0, 0], sh[0, 1], x0, y0, x1, y1)
+        d1 = point_segment_2d(sh[1, 0], sh[1, 1], x0, y0, x1, y1)
+        if d0 < margin or d1 < margin:
+            near[n] = f
+            n += 1
+    return n
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _edge_detour(sx, sy, sz, qx, qy, qz, ex, ey, ez, dx, dy, dz, length):
+    """Shortest path s -> e -> q with e on the edge (ex, ey, ez) + t d, t in [0, length]; returns (len, t)."""
+    ts = (sx - ex) * dx + (sy - ey) * dy + (sz - ez) * dz
+    tq = (qx - ex) * dx + (qy - ey) * dy + (qz - ez) * dz
+    rs = np.sqrt(max(0.0, (sx - ex) ** 2 + (sy - ey) ** 2 + (sz - ez) ** 2 - ts * ts))
+    rq = np.sqrt(max(0.0, (qx - ex) ** 2 + (qy - ey) ** 2 + (qz - ez) ** 2 - tq * tq))
+    t = ts if rs + rq <= 1e-12 else ts + (tq - ts) * rs / (rs + rq)
+    t = 0.0 if t < 0.0 else (length if t > length else t)
+    px, py, pz = ex + t * dx, ey + t * dy, ez + t * dz
+    d1 = np.sqrt((sx - px) ** 2 + (sy - py) ** 2 + (sz - pz) ** 2)
+    d2 = np.sqrt((qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2)
+    return d1 + d2, t
+
+
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def _path_clear(fences, near, n_near, ax, ay, az, bx, by, bz):
+    """No near fence panel lies across the straight segment a-b."""
+    return blocking_panel(fences, near, n_near, ax, ay, az, bx, by, bz) < 0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _panel_across(fences, i, ax, ay, az, bx, by, bz):
+    """Fence panel i lies across the straight segment a-b."""
+    ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
+    nx, ny = -uy, ux
+    sa = (ax - fences[i, 0]) * nx + (ay - fences[i, 1]) * ny
+    sb = (bx - fences[i, 0]) * nx + (by - fences[i, 1]) * ny
+    if sa * sb >= 0.0:
+        return False
+    t = sa / (sa - sb)
+    cx, cy, cz = ax + t * (bx - ax), ay + t * (by - ay), az + t * (bz - az)
+    u = ((cx - fences[i, 0]) * ux + (cy - fences[i, 1]) * uy) / (ux * ux + uy * uy)
+    return 0.0 <= u <= 1.0 and fences[i, 4] <= cz <= fences[i, 5]
+
+
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def blocking_panel(fences, near, n_near, ax, ay, az, bx, by, bz):
+    """The index into ``near`` of the first near fence panel across the straight segment a-b, or -1."""
+    for m in range(n_near):
+        if _panel_across(fences, near[m], ax, ay, az, bx, by, bz):
+            return m
+    return -1
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _panel_edges(fences, i, sx, sy, sz, qx, qy, qz):
+    """The shortest paths s -> e -> q over panel i's top edge and around its two end edges, as (length,
+    position along the edge) each: (top, t_top, first end, t_first, second end, t_second)."""
+    ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
+    w = np.sqrt(ux * ux + uy * uy)
+    ux /= w
+    uy /= w
+    top, t_top = _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 5], ux, uy, 0.0, w)
+    height = fences[i, 5] - fences[i, 4]
+    end0, t0 = _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 4], 0.0, 0.0, 1.0, height)
+    end1, t1 = _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 2], fences[i, 3], fences[i, 4], 0.0, 0.0, 1.0, height)
+    return top, t_top, end0, t0, end1, t1
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _around_panel(fences, i, sx, sy, sz, qx, qy, qz, top, end0, end1):
+    """A lower bound on any path from s to q that passes panel i, when the straight path crosses it, given
+    the panel's edge detours ``top``, ``end0``, ``end1`` (``_panel_edges``).
+
+    The path must cross the panel's plane outside the panel, and |s - c| + |c - q| over the plane is convex
+    with its minimum inside the panel, so the shortest such crossing lies on the panel's border: the least
+    of the four edge detours. The bottom edge counts only if s or q lies at or below it: otherwise a path
+    below the panel would have to dip under the panel and come back up, and the segment from such a crossing
+    to the straight path's crossing enters the panel through an end edge or the top, at no greater length."""
+    lb = min(top, end0, end1)
+    if fences[i, 4] < min(sz, qz):
+        return lb
+    ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
+    w = np.sqrt(ux * ux + uy * uy)
+    return min(lb, _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 4], ux / w, uy / w,
+                                0.0, w)[0])
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
+    """(fence_detour's length, a lower bound of it that moves by at most |dq| with q).
+
+    The bound is |s - q| where nothing is in the way, else the largest ``_around_panel`` of the panels in
+    the way (every way round must pass each of them). Each term is 1-Lipschitz in q, and a panel's term
+    equals |s - q| where q's straight path starts or stops crossing it (at the panel's border), so the bound
+    is continuous and 1-Lipschitz except where q itself passes through a panel, where it can drop."""
+    around = -1.0
+    first = -1  # the first panel in the way: its edge detours are reused below
+    first_edges = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    for m in range(n_near):
+        if _panel_across(fences, near[m], sx, sy, sz, qx, qy, qz):
+            e = _panel_edges(fences, near[m], sx, sy, sz, qx, qy, qz)
+            a = _around_panel(fences, near[m], sx, sy, sz, qx, qy, qz, e[0], e[2], e[4])
+            around = a if a > around else around
+            if first < 0:
+                first = m
+                first_edges = e
+    if around < 0.0:
+        d = np.sqrt((sx - qx) ** 2 + (sy - qy) ** 2 + (sz - qz) ** 2)
+        return d, d
+    if cutoff < np.inf and around - 1e-9 >= cutoff:
+        return cutoff, around
+    best = cutoff
+    nudge = 0.01  # step the bend point off the panel so the crossing tests are not degenerate
+    for m in range(n_near):
+        i = near[m]
+        ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
+        w = np.sqrt(ux * ux + uy * uy)
+        ux /= w
+        uy /= w
+        if m == first:
+            top, t_top, end0, t0, end1, t1 = first_edges
+        else:
+            top, t_top, end0, t0, end1, t1 = _panel_edges(fences, i, sx, sy, sz, qx, qy, qz)
+        for edge in range(3):
+            if edge == 0:  # top edge
+                length, t = top, t_top
+                ex, ey, ez = fences[i, 0] + t * ux, fences[i, 1] + t * uy, fences[i, 5] + nudge
+            else:  # vertical end edges
+                sgn = -1.0 if edge == 1 else 1.0
+                bx = fences[i, 0] if edge == 1 else fences[i, 2]
+                by = fences[i, 1] if edge == 1 else fences[i, 3]
+                length, t = (end0, t0) if edge == 1 else (end1, t1)
+                ex, ey, ez = bx + sgn * nudge * ux, by + sgn * nudge * uy, fences[i, 4] + t
+            if (length < best and _path_clear(fences, near, n_near, sx, sy, sz, ex, ey, ez)
+                    and _path_clear(fences, near, n_near, ex, ey, ez, qx, qy, qz)):
+                best = length
+    return best, around
+
+
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff=np.inf):
+    """Length of the shortest arm path from shoulder s to q around the near fence panels, over their top
+    edge or around their ends (inf if every such path is blocked); |s - q| when nothing is in the way.
+
+    A finite ``cutoff`` says that any length from it up will do: the result is exact below it and ``cutoff``
+    otherwise, and bends that are not shorter are not checked for crossings (most of the cost). If even the
+    way around one of the panels in the way is that long, no bend is looked at."""
+    return _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff)[0]
+
+
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def fence_detour_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
+    """``fence_detour`` and its 1-Lipschitz lower bound (see ``_detour_and_bound``)."""
+    return _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff)

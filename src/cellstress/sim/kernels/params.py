@@ -1,0 +1,77 @@
+"""The arrays the kernels run on: ``SimParams`` (one per cell, built by ``sim.build``) and ``Work`` (scratch
+space, one set per thread of stepping)."""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from cellstress.sim.layout import N_BODY_CAPSULES
+
+
+class SimParams(NamedTuple):
+    scal: np.ndarray  # (N_SCAL,) laid out as sim.layout.SCALARS
+    spa: int  # steps per action
+    act: np.ndarray  # (n_actions, 4): walks, heading change, target forward / lateral flexion
+    body: np.ndarray  # (N_BODY_PARAMS,) laid out as sim.layout.BODY_PARAMS
+    base: np.ndarray  # (4, 4) robot base in the world
+    parents: np.ndarray  # (nj,) int64
+    placements: np.ndarray  # (nj, 4, 4)
+    axes: np.ndarray  # (nj, 3)
+    anc: np.ndarray  # (nj, nj) float: 1 where column joint moves row joint's origin
+    wp: np.ndarray  # (nw, nj) waypoints
+    seg_start: np.ndarray  # (nw,)
+    seg_move: np.ndarray  # (nw,)
+    cap_joint: np.ndarray  # (nc,) int64, -1 = base
+    cap_a: np.ndarray  # (nc, 3)
+    cap_b: np.ndarray  # (nc, 3)
+    cap_r: np.ndarray  # (nc,)
+    reach: np.ndarray  # (n, n, n) float32 signed distance
+    fences: np.ndarray  # (nf, 6) x0 y0 x1 y1 zlo zhi
+    table_verts: np.ndarray  # (V, 2)
+    table_poly: np.ndarray  # (T, 2) int64 start, count
+    floor: np.ndarray  # (4,) xmin xmax ymin ymax
+    dev_kind: np.ndarray  # (nd,) int64
+    dev_resp: np.ndarray  # (nd,)
+    dev_rect: np.ndarray  # (nd, 6) curtain rectangle; for scanners [4] holds the scan height
+    dev_poly: np.ndarray  # (nd, 2) int64 start, count into dev_verts
+    dev_verts: np.ndarray  # (V, 2)
+    pre_ra: np.ndarray  # (n_pre, nc, 3) robot capsules at step k before any stop (a cache: see robot_at)
+    pre_rb: np.ndarray
+    pre_v: np.ndarray  # (n_pre,) v_R
+    pre_tau: np.ndarray  # (n_pre,) path time
+
+
+class Work(NamedTuple):
+    q: np.ndarray
+    qd: np.ndarray
+    rot: np.ndarray
+    pos: np.ndarray
+    ra: np.ndarray
+    rb: np.ndarray
+    ha: np.ndarray
+    hb: np.ndarray
+    hr: np.ndarray
+    sh: np.ndarray
+    tr: np.ndarray
+    near: np.ndarray
+    best_r: np.ndarray
+    lbs: np.ndarray
+    ts: np.ndarray
+    stopped: np.ndarray  # (2,) t_stop, v_R of the standstill pose held in ra/rb, or NaN (see robot_at)
+
+
+@njit(cache=True, error_model="numpy")
+def make_work(P):
+    nj = P.placements.shape[0]
+    nc = P.cap_r.shape[0]
+    return Work(
+        np.zeros(nj), np.zeros(nj), np.zeros((nj, 3, 3)), np.zeros((nj, 3)),
+        np.zeros((nc, 3)), np.zeros((nc, 3)),
+        np.zeros((N_BODY_CAPSULES, 3)), np.zeros((N_BODY_CAPSULES, 3)), np.zeros(N_BODY_CAPSULES),
+        np.zeros((2, 3)), np.zeros((3, 3)), np.zeros(P.fences.shape[0] + 1, dtype=np.int64),
+        np.zeros(3),
+        np.zeros(2 * nc), np.zeros(2 * nc), np.full(2, np.nan),
+    )

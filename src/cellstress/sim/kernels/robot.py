@@ -1,0 +1,221 @@
+"""The robot: its cyclic minimum-jerk path, forward kinematics, capsules and speed, at any time and stop.
+
+The robot is a pure function of time and of the moment its stop takes effect: its path time advances one
+second per second until the stop, then slows linearly to a standstill within the stopping time, so
+tau(t) = t_s + d - d^2 / (2 T) for d = t - t_s < T. Nothing is integrated, so nothing drifts.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from cellstress.sim.kernels.params import make_work
+from cellstress.sim.layout import (
+    C_CYCLE,
+    C_DT,
+    C_DWELL,
+    C_PHASE0,
+    C_STOP_TIME,
+    PHASE_BRAKING,
+    PHASE_PENDING,
+    PHASE_RUNNING,
+    PHASE_STOPPED,
+)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def path_time(scal, t, t_stop):
+    """(path time tau, time-scaling sigma = dtau/dt, stop phase) at time t for a stop effective at t_stop."""
+    T = scal[C_STOP_TIME]
+    tau0 = scal[C_PHASE0]
+    if not t_stop < np.inf:
+        return tau0 + t, 1.0, PHASE_RUNNING
+    if t < t_stop:
+        return tau0 + t, 1.0, PHASE_PENDING
+    d = t - t_stop
+    if d >= T:
+        return tau0 + t_stop + 0.5 * T, 0.0, PHASE_STOPPED
+    return tau0 + t_stop + d - d * d / (2.0 * T), 1.0 - d / T, PHASE_BRAKING
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _joint_trajectory(scal, seg_start, seg_move, wp, tau, sigma, q, qd):
+    """Joint positions and velocities on the cyclic minimum-jerk path at path time tau."""
+    cycle = scal[C_CYCLE]
+    dwell = scal[C_DWELL]
+    tc = tau - cycle * np.floor(tau / cycle)
+    nw = seg_start.shape[0]
+    i = nw - 1
+    for k in range(1, nw):
+        if tc < seg_start[k]:
+            i = k - 1
+            break
+    j = i + 1 if i + 1 < nw else 0
+    T = seg_move[i]
+    u = (tc - seg_start[i] - dwell) / T
+    nj = q.shape[0]
+    if u <= 0.0:
+        for k in range(nj):
+            q[k] = wp[i, k]
+            qd[k] = 0.0
+        return
+    if u > 1.0:
+        u = 1.0
+    s = u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
+    ds = 30.0 * u * u * (1.0 - u) * (1.0 - u) / T * sigma
+    for k in range(nj):
+        dq = wp[j, k] - wp[i, k]
+        q[k] = wp[i, k] + s * dq
+        qd[k] = ds * dq
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _forward_kinematics(parents, placements, base, axes, q, rot, pos):
+    """World rotation and origin of every joint frame."""
+    # (No temporary array and no row views: each would be allocated or reference-counted on every call.)
+    nj = q.shape[0]
+    for j in range(nj):
+        par = parents[j]
+        # parent frame in the world; its rotation part goes to rot[j] for now
+        for r in range(3):
+            for c in range(3):
+                acc = 0.0
+                for k in range(3):
+                    pr = base[r, k] if par < 0 else rot[par, r, k]
+                    acc += pr * placements[j, k, c]
+                rot[j, r, c] = acc
+        for r in range(3):
+            acc = base[r, 3] if par < 0 else pos[par, r]
+            for k in range(3):
+                pr = base[r, k] if par < 0 else rot[par, r, k]
+                acc += pr * placements[j, k, 3]
+            pos[j, r] = acc
+        # rotation about the joint axis (Rodrigues)
+        kx, ky, kz = axes[j, 0], axes[j, 1], axes[j, 2]
+        c, s = np.cos(q[j]), np.sin(q[j])
+        v = 1.0 - c
+        r00, r01, r02 = c + kx * kx * v, kx * ky * v - kz * s, kx * kz * v + ky * s
+        r10, r11, r12 = ky * kx * v + kz * s, c + ky * ky * v, ky * kz * v - kx * s
+        r20, r21, r22 = kz * kx * v - ky * s, kz * ky * v + kx * s, c + kz * kz * v
+        for r in range(3):
+            a0, a1, a2 = rot[j, r, 0], rot[j, r, 1], rot[j, r, 2]
+            rot[j, r, 0] = a0 * r00 + a1 * r10 + a2 * r20
+            rot[j, r, 1] = a0 * r01 + a1 * r11 + a2 * r21
+            rot[j, r, 2] = a0 * r02 + a1 * r12 + a2 * r22
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _fastest_joint_speed(anc, axes, qd, rot, pos):
+    """v_R: the largest Cartesian speed of any joint origin (the paper's 'fastest robot joint')."""
+    nj = qd.shape[0]
+    best = 0.0
+    for i in range(nj):
+        vx = vy = vz = 0.0
+        for j in range(i):
+            if anc[i, j] == 0.0:
+                continue
+            wx = rot[j, 0, 0] * axes[j, 0] + rot[j, 0, 1] * axes[j, 1] + rot[j, 0, 2] * axes[j, 2]
+            wy = rot[j, 1, 0] * axes[j, 0] + rot[j, 1, 1] * axes[j, 1] + rot[j, 1, 2] * axes[j, 2]
+            wz = rot[j, 2, 0] * axes[j, 0] + rot[j, 2, 1] * axes[j, 1] + rot[j, 2, 2] * axes[j, 2]
+            dx, dy, dz = pos[i, 0] - pos[j, 0], pos[i, 1] - pos[j, 1], pos[i, 2] - pos[j, 2]
+            vx += qd[j] * (wy * dz - wz * dy)
+            vy += qd[j] * (wz * dx - wx * dz)
+            vz += qd[j] * (wx * dy - wy * dx)
+        sp = np.sqrt(vx * vx + vy * vy + vz * vz)
+        if sp > best:
+            best = sp
+    return best
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _robot_capsules(cap_joint, cap_a, cap_b, base, rot, pos, ra, rb):
+    for c in range(cap_joint.shape[0]):
+        j = cap_joint[c]
+        for r in range(3):
+            ax = base[r, 3] if j < 0 else pos[j, r]
+            bx = ax
+            for k in range(3):
+                m = base[r, k] if j < 0 else rot[j, r, k]
+                ax += m * cap_a[c, k]
+                bx += m * cap_b[c, k]
+            ra[c, r] = ax
+            rb[c, r] = bx
+
+
+@njit(cache=True, error_model="numpy")
+def robot_live(P, t, t_stop, W):
+    """Pose the robot at time t: capsules into W.ra/W.rb. Returns (v_R, stop phase, path time)."""
+    W.stopped[0] = np.nan
+    return _robot_live(P.scal, P.seg_start, P.seg_move, P.wp, P.parents, P.placements, P.base, P.axes, P.anc,
+                       P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot, W.pos, W.ra, W.rb, t, t_stop)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _robot_live(scal, seg_start, seg_move, wp, parents, placements, base, axes, anc, cap_joint, cap_a, cap_b,
+                q, qd, rot, pos, ra, rb, t, t_stop):
+    tau, sigma, phase = path_time(scal, t, t_stop)
+    _joint_trajectory(scal, seg_start, seg_move, wp, tau, sigma, q, qd)
+    _forward_kinematics(parents, placements, base, axes, q, rot, pos)
+    _robot_capsules(cap_joint, cap_a, cap_b, base, rot, pos, ra, rb)
+    return _fastest_joint_speed(anc, axes, qd, rot, pos), phase, tau
+
+
+# The same with SimParams / Work, for callers outside the hot loop (tests, scene, the ISO check).
+@njit(cache=True, error_model="numpy")
+def joint_trajectory(P, tau, sigma, q, qd):
+    _joint_trajectory(P.scal, P.seg_start, P.seg_move, P.wp, tau, sigma, q, qd)
+
+
+@njit(cache=True, error_model="numpy")
+def forward_kinematics(P, q, rot, pos):
+    _forward_kinematics(P.parents, P.placements, P.base, P.axes, q, rot, pos)
+
+
+@njit(cache=True, error_model="numpy")
+def fastest_joint_speed(P, qd, rot, pos):
+    return _fastest_joint_speed(P.anc, P.axes, qd, rot, pos)
+
+
+@njit(cache=True, error_model="numpy")
+def robot_capsules(P, rot, pos, ra, rb):
+    _robot_capsules(P.cap_joint, P.cap_a, P.cap_b, P.base, rot, pos, ra, rb)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def robot_at(P, k, t_stop, W):
+    """The robot at step k. Until a stop takes effect every episode moves the robot identically, so those
+    steps come from a table made once per cell by the same code (bit-identical to computing them). Once the
+    robot stands, its pose no longer changes: W.stopped = (t_stop, v_R) marks that W.ra/W.rb hold the
+    standstill pose for that stop (NaN: they do not)."""
+    scal, ra, rb, stopped = P.scal, W.ra, W.rb, W.stopped
+    t = k * scal[C_DT]
+    pre_v = P.pre_v
+    if t < t_stop and k < pre_v.shape[0]:
+        pre_ra, pre_rb = P.pre_ra, P.pre_rb
+        for c in range(ra.shape[0]):
+            for r in range(3):
+                ra[c, r] = pre_ra[k, c, r]
+                rb[c, r] = pre_rb[k, c, r]
+        stopped[0] = np.nan
+        return pre_v[k], (PHASE_RUNNING if t_stop == np.inf else PHASE_PENDING), P.pre_tau[k]
+    if stopped[0] == t_stop and t - t_stop >= scal[C_STOP_TIME]:
+        tau, _, phase = path_time(scal, t, t_stop)
+        return stopped[1], phase, tau
+    v, phase, tau = _robot_live(scal, P.seg_start, P.seg_move, P.wp, P.parents, P.placements, P.base, P.axes,
+                                P.anc, P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot, W.pos, ra, rb, t, t_stop)
+    if phase == PHASE_STOPPED:
+        stopped[0], stopped[1] = t_stop, v
+    else:
+        stopped[0] = np.nan
+    return v, phase, tau
+
+
+@njit(cache=True, error_model="numpy")
+def robot_table(P, n, ra, rb, v, tau):
+    """Fill the pre-stop robot table for steps 0..n-1."""
+    W = make_work(P)
+    for k in range(n):
+        v[k], _, tau[k] = robot_live(P, k * P.scal[C_DT], np.inf, W)
+        ra[k] = W.ra
+        rb[k] = W.rb

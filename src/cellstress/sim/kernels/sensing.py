@@ -1,0 +1,85 @@
+"""What the worker's body touches without the robot: the devices that see it, and the limits of where it
+can stand (floor, table, fences) and lean (no trunk through a fence)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from cellstress.human.body import WALK_BLOCK_HEIGHT
+from cellstress.sim.geometry import point_segment_2d, polygon_distance, segment_rectangle_xyz
+from cellstress.sim.layout import B_HEAD_RISE, B_R_HEAD, B_R_TRUNK, B_SHOULDER_HALF, DEV_SCANNER, N_BODY_CAPSULES
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
+    """Does device d detect the worker: a body capsule (legs, trunk, head, arms at rest) in its region?
+
+    The reach volumes are not seen: they stand for where an arm *could* strike, and the worst-case worker
+    keeps the arm back until it can. ISO 13855's reach allowance C covers exactly this.
+    """
+    if dev_kind[d] == DEV_SCANNER:
+        H = dev_rect[d, 4]
+        start, count = dev_poly[d, 0], dev_poly[d, 1]
+        for c in range(N_BODY_CAPSULES):
+            a0, a1, a2, b0, b1, b2, r = ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2], hr[c]
+            lo, hi = min(a2, b2), max(a2, b2)
+            if H < lo - r or H > hi + r:
+                continue
+            if b2 == a2:
+                t = 0.0
+            else:
+                t = (H - a2) / (b2 - a2)
+                t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
+            px, py, pz = a0 + t * (b0 - a0), a1 + t * (b1 - a1), a2 + t * (b2 - a2)
+            dz = abs(pz - H)
+            if dz > r:
+                continue
+            if polygon_distance(px, py, dev_verts, start, count) <= np.sqrt(r * r - dz * dz):
+                return True
+    else:
+        x0, y0, x1, y1, zlo, zhi = dev_rect[d, 0], dev_rect[d, 1], dev_rect[d, 2], dev_rect[d, 3], \
+            dev_rect[d, 4], dev_rect[d, 5]
+        # no body capsule is further than this from the hip axis in plan view
+        extent = body[B_SHOULDER_HALF] + body[B_R_TRUNK] + body[B_HEAD_RISE]
+        if point_segment_2d(ha[2, 0], ha[2, 1], x0, y0, x1, y1) > extent:
+            return False
+        for c in range(N_BODY_CAPSULES):
+            if segment_rectangle_xyz(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2],
+                                     x0, y0, x1, y1, zlo, zhi)[0] <= hr[c]:
+                return True
+    return False
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def feet_ok(r, fl, table_verts, table_poly, fences, x, y):
+    """The footprint circle (radius r) stays on the floor, off the table and clear of fence panels."""
+    if x - r < fl[0] or x + r > fl[1] or y - r < fl[2] or y + r > fl[3]:
+        return False
+    for t in range(table_poly.shape[0]):
+        if polygon_distance(x, y, table_verts, table_poly[t, 0], table_poly[t, 1]) < r:
+            return False
+    for f in range(fences.shape[0]):
+        if fences[f, 4] < WALK_BLOCK_HEIGHT and \
+                point_segment_2d(x, y, fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3]) < r:
+            return False
+    return True
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def trunk_clear(body, fences, ha, hb, hr):
+    """Trunk, head and arms (from the shoulders down) do not pass through any fence panel.
+
+    The shoulders matter most: the reach volumes hang on them, so a shoulder past a panel would reach
+    around it for free. (Where the hands can get past a panel is limited separately, by fence_detour.)
+    """
+    extent = body[B_HEAD_RISE] + body[B_R_HEAD] + body[B_SHOULDER_HALF]
+    for f in range(fences.shape[0]):
+        x0, y0, x1, y1, zlo, zhi = fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3], fences[f, 4], fences[f, 5]
+        if point_segment_2d(ha[2, 0], ha[2, 1], x0, y0, x1, y1) > extent:
+            continue
+        for c in (2, 3, 4, 5):
+            if segment_rectangle_xyz(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2],
+                                     x0, y0, x1, y1, zlo, zhi)[0] < hr[c]:
+                return False
+    return True

@@ -1,0 +1,210 @@
+"""One time step: move the worker, sense (devices latch a stop), pose the robot, measure; and the worker's
+own motion and distances without the robot, for searchers that plan with it.
+
+The lifecycle follows dm_control's composer: move the worker -> sense -> move the robot -> measure. The step
+(step_action, sense_and_measure and the non-inlined helpers they call) allocates nothing and is compiled
+without reference counting (``geometry.NO_REFCOUNT``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from cellstress.sim.geometry import NO_REFCOUNT, segment_segment_xyz
+from cellstress.sim.kernels.body import pose_body
+from cellstress.sim.kernels.fences import collect_near_fences
+from cellstress.sim.kernels.reach import reach_value_at
+from cellstress.sim.kernels.robot import robot_at
+from cellstress.sim.kernels.sensing import device_sees, feet_ok, trunk_clear
+from cellstress.sim.kernels.separation import separation
+from cellstress.sim.layout import (
+    B_ARM_LEN,
+    B_BODY_RADIUS,
+    B_WALK_SPEED,
+    C_DT,
+    C_DTOL,
+    C_REACH_H,
+    C_REACH_ORIGIN,
+    C_VTOL,
+    M_ACTION,
+    M_FWD,
+    M_HEADING,
+    M_LAT,
+    M_PHASE,
+    M_SEEN,
+    M_STEP,
+    M_T,
+    M_TAU,
+    M_UNSAFE,
+    M_V,
+    M_X,
+    M_Y,
+    N_BODY_CAPSULES,
+    NS,
+    S_ACTIONS,
+    S_FWD,
+    S_HEADING,
+    S_K,
+    S_LAT,
+    S_TRIG_DEV,
+    S_TRIG_T,
+    S_TSTOP,
+    S_UNSAFE,
+    S_X,
+    S_Y,
+)
+
+
+# Not inlined: it is called from three entry points, and numba's IR inlining of this much nested code made a
+# cold compile take 5 minutes instead of under 2 (for about 5 % of run time on baseline).
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def sense_and_measure(P, state, W, row, action):
+    """At the state's time: devices latch stops, the robot is posed, d_HR and v_R are measured."""
+    dt = P.scal[C_DT]
+    k = state[S_K]
+    t = k * dt
+    ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
+    pose_body(P.body, state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT], ha, hb, hr, sh, tr)
+    n_near = collect_near_fences(P.fences, sh, W.near, P.body[B_ARM_LEN] + 0.05)
+    seen = 0
+    dev_kind, dev_rect, dev_poly, dev_verts, body = P.dev_kind, P.dev_rect, P.dev_poly, P.dev_verts, P.body
+    for d in range(dev_kind.shape[0]):
+        if device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
+            seen |= 1 << d
+            t_s = t + P.dev_resp[d]
+            if t_s < state[S_TSTOP]:
+                state[S_TSTOP] = t_s
+                if state[S_TRIG_DEV] < 0:
+                    state[S_TRIG_T] = t
+                state[S_TRIG_DEV] = d
+    v, phase, tau = robot_at(P, int(k), state[S_TSTOP], W)
+    cap_r, reach, origin, grid_h, arm_len, fences = P.cap_r, P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], \
+        P.body[B_ARM_LEN], P.fences
+    ra, rb, near, lbs, ts, q = W.ra, W.rb, W.near, W.lbs, W.ts, W.best_r
+    if n_near == 0:
+        # the common case, compiled separately so that the fence-detour code drops out of it
+        d_hr = separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
+                          0, row)
+    else:
+        d_hr = separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
+                          n_near, row)
+    unsafe = d_hr <= P.scal[C_DTOL] and v > P.scal[C_VTOL]
+    row[M_T] = t
+    row[M_X], row[M_Y], row[M_HEADING] = state[S_X], state[S_Y], state[S_HEADING]
+    row[M_FWD], row[M_LAT] = state[S_FWD], state[S_LAT]
+    row[M_V] = v
+    row[M_SEEN] = seen
+    row[M_PHASE] = phase
+    row[M_UNSAFE] = 1.0 if unsafe else 0.0
+    row[M_TAU] = tau
+    row[M_ACTION] = action
+    row[M_STEP] = k
+    if unsafe:
+        state[S_UNSAFE] = 1.0
+    return unsafe
+
+
+@njit(cache=True, error_model="numpy")
+def reset_state(P, x, y, heading, state, W, row):
+    state[:] = 0.0
+    state[S_X], state[S_Y], state[S_HEADING] = x, y, heading
+    state[S_TSTOP] = np.inf
+    state[S_TRIG_DEV] = -1.0
+    state[S_TRIG_T] = -1.0
+    sense_and_measure(P, state, W, row, -1)
+
+
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def step_action(P, state, action, W, out, row0):
+    """Play one action (P.spa time steps) from ``state`` in place; rows go to out[row0:]. Returns rows written.
+
+    Stops early at the first unsafe step. A state that is already unsafe does not move.
+    """
+    if state[S_UNSAFE] != 0.0:
+        return 0
+    spa = P.spa
+    h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
+    n = 0
+    for j in range(1, spa + 1):
+        move_worker(P, state, action, h0, f0, l0, j / spa, W)
+        state[S_K] += 1.0
+        unsafe = sense_and_measure(P, state, W, out[row0 + n], action)
+        n += 1
+        if unsafe:
+            break
+    state[S_ACTIONS] += 1.0
+    return n
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def move_worker(P, state, action, h0, f0, l0, frac, W):
+    """The worker's own motion over one time step of ``action`` (begun at heading h0 and posture f0, l0):
+    ``frac`` of the action done. It depends on the actions and the fixed layout only, never on the robot."""
+    walks = P.act[action, 0]
+    body, fences, floor, table_verts, table_poly = P.body, P.fences, P.floor, P.table_verts, P.table_poly
+    ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
+    x, y = state[S_X], state[S_Y]
+    h = h0 + P.act[action, 1] * frac
+    f = f0 + (P.act[action, 2] - f0) * frac
+    lt = l0 + (P.act[action, 3] - l0) * frac
+    nx, ny = x, y
+    if walks != 0.0:
+        stride = body[B_WALK_SPEED] * P.scal[C_DT]
+        nx, ny = x + stride * np.cos(h), y + stride * np.sin(h)
+        if not feet_ok(body[B_BODY_RADIUS], floor, table_verts, table_poly, fences, nx, ny):
+            nx, ny = x, y
+    pose_body(body, nx, ny, h, f, lt, ha, hb, hr, sh, tr)
+    if not trunk_clear(body, fences, ha, hb, hr):
+        # the new posture would put the trunk through a fence: keep the old posture where it stands
+        pose_body(body, nx, ny, state[S_HEADING], state[S_FWD], state[S_LAT], ha, hb, hr, sh, tr)
+        if trunk_clear(body, fences, ha, hb, hr):
+            h, f, lt = state[S_HEADING], state[S_FWD], state[S_LAT]
+        else:
+            nx, ny, h, f, lt = x, y, state[S_HEADING], state[S_FWD], state[S_LAT]
+    state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT] = nx, ny, h, f, lt
+
+
+@njit(cache=True, error_model="numpy")
+def worker_paths(P, s0, actions, W, out):
+    """The worker's poses (x, y, heading, forward, lateral flexion) at every time step of each episode of
+    ``actions`` (n, n_actions) played from s0, as if no contact ended it: the open-loop part of the simulation
+    (``move_worker``), without robot, devices or measuring. out: (n, n_actions * spa, 5)."""
+    state = np.empty(NS)
+    spa = P.spa
+    for e in range(actions.shape[0]):
+        state[:] = s0
+        k = 0
+        for a in range(actions.shape[1]):
+            h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
+            for j in range(1, spa + 1):
+                move_worker(P, state, actions[e, a], h0, f0, l0, j / spa, W)
+                out[e, k, 0], out[e, k, 1], out[e, k, 2] = state[S_X], state[S_Y], state[S_HEADING]
+                out[e, k, 3], out[e, k, 4] = state[S_FWD], state[S_LAT]
+                k += 1
+
+
+@njit(cache=True, error_model="numpy")
+def worker_point_distances(P, W, poses, points, out):
+    """out[i, j]: distance from the worker at poses[i] (x, y, heading, forward, lateral flexion) to the point
+    points[i, j], as ``separation`` measures the worker's side of d_HR: the nearer of the two reach volumes
+    (fences respected) and the body capsules; inf for a NaN point. The robot plays no part."""
+    arm, origin, grid_h = P.body[B_ARM_LEN], P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H]
+    ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
+    for i in range(poses.shape[0]):
+        pose_body(P.body, poses[i, 0], poses[i, 1], poses[i, 2], poses[i, 3], poses[i, 4], ha, hb, hr, sh, tr)
+        n_near = collect_near_fences(P.fences, sh, W.near, arm + 0.05)
+        for j in range(points.shape[1]):
+            px, py, pz = points[i, j, 0], points[i, j, 1], points[i, j, 2]
+            if np.isnan(px):
+                out[i, j] = np.inf
+                continue
+            best = np.inf
+            for side in range(2):
+                best = min(best, reach_value_at(P.reach, origin, grid_h, arm, P.fences, W.near, sh, tr, side, n_near,
+                                              px, py, pz))
+            for c in range(N_BODY_CAPSULES):
+                d2 = segment_segment_xyz(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2],
+                                         px, py, pz, px, py, pz)[0]
+                best = min(best, np.sqrt(d2) - hr[c])
+            out[i, j] = best
