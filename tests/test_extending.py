@@ -59,8 +59,8 @@ def _my_cell(folder: Path) -> Path:
 
 
 def _run(line: str, cwd: Path, env: dict[str, str]) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "cellstress", *shlex.split(line)[1:]], capture_output=True,
-                          text=True, cwd=cwd, env=env, timeout=600)
+    return subprocess.run([sys.executable, "-m", "cellstress", *shlex.split(line, comments=True)[1:]],
+                          capture_output=True, text=True, cwd=cwd, env=env, timeout=600)
 
 
 def test_the_plugins_show_up_and_run(installed, tmp_path):
@@ -70,7 +70,8 @@ def test_the_plugins_show_up_and_run(installed, tmp_path):
     outs = {}
     for line in lines:
         out = _run(line, tmp_path, installed)
-        assert out.returncode == 0, (line, out.stderr)
+        expected = int(m[1]) if (m := re.search(r"#\s*exit code (\d)", line)) else 0
+        assert out.returncode == expected, (line, out.stderr)
         outs[line.split()[1]] = outs.get(line.split()[1], "") + out.stdout
     assert re.search(r"front-mat\s+example-mat\s+response 0\.1 s\s+4-point mat", outs["check"])
     assert "front-mat (example-mat): T = 0.10 + 0.15 s, S = 1600*0.25 + 1200 = 1600 mm" in outs["check"]

@@ -304,6 +304,9 @@ NAMED: list[Case] = [
     Case("name-absolute-show", ("show", CELL), 0, cell=_set("name", "/tmp/x"), creates=("tmp-x.png",)),
     Case("description-escape-check", ("check", CELL), 0, cell=_set("description", "safe\x1b]0;owned\x07 cell"),
          check=_no_raw()),
+    Case("campaign-runs-symlink-planted", ("campaign", "--cells", "baseline", "--searchers", "random", "--seeds",
+                                           "1", "--budget", "2", "--workers", "1", "--out", "out"), 2,
+         ("out",), setup=_link("out/runs.jsonl", "../in/victim.txt")),
     Case("report-symlink-planted", ("report", RESULT), 0, result=lambda d: None,
          setup=_link("out/report.html", "../in/victim.txt"),
          check=lambda folder, out, err: (

@@ -168,6 +168,20 @@ def test_low_fence_counts_as_open(tmp_path):
     assert any(not p.closed and "ISO 13857" in p.reason for p in r.fences)
 
 
+def test_the_reach_line_names_only_the_devices_the_cell_has(tmp_path):
+    """A cell with only a curtain is not told to keep away from scanner fields (and one with none from either)."""
+    data = yaml.safe_load(builtin_text("baseline"))
+    data["devices"] = [d for d in data["devices"] if d["type"] == "light-curtain"]
+    path = tmp_path / "curtain-only.yaml"
+    path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    line = next(ln for ln in iso.check_cell(load_cell(str(path))).lines() if ln.startswith("undetected reach"))
+    assert "from curtains" in line and "scanner" not in line
+    data["devices"] = []
+    path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    line = next(ln for ln in iso.check_cell(load_cell(str(path))).lines() if ln.startswith("undetected reach"))
+    assert "no detection zone to keep away from" in line and "scanner" not in line and "curtain" not in line
+
+
 # ---- geometry on toy cases --------------------------------------------------------------------------------
 def test_open_intervals():
     covers = [((0.0, 0.0), (1.0, 0.0)), ((2.0, 0.0), (5.0, 0.0)), ((1.5, 0.1), (1.8, 0.1))]

@@ -88,3 +88,25 @@ def test_distinct_needs_until_budget(tmp_path):
     assert out.returncode == 2 and out.stderr.strip() == "error: --distinct needs --until budget"
     with pytest.raises(Exception, match="distinct needs"):
         search(load_cell("all-flaws"), "mcts", 10, 0, distinct=True)
+
+
+def test_root_causes_group_the_classes_and_links_split_the_chain_in_thirds() -> None:
+    """One safeguard and one body area are one root cause, whatever the link, the hand or forearm and the floor
+    cell; the UR10's links fall into the thirds of its chain from the base."""
+    from cellstress.searchers.distinct import link_group, root_cause
+    from cellstress.searchers.result import HazardClass
+    from cellstress.sim.simulator import Simulator
+
+    layout = Simulator("baseline").layout
+    thirds = {c.name: link_group(layout, c.name) for c in layout.capsules}
+    assert thirds["base_link"] == thirds["shoulder_link"] == thirds["upper_arm_link"] == "base side"
+    assert thirds["forearm_link"] == thirds["wrist_1_link"] == "middle"
+    assert thirds["wrist_2_link"] == thirds["wrist_3_link"] == "wrist and tool"
+
+    def klass(device, link, region, x):
+        return HazardClass(device=device, robot_link=link, body_region=region, approach_cell=(x, 0.0, x + 0.5, 0.5))
+
+    same = [klass("bay-curtain", "forearm_link", "hands", 0.0), klass("bay-curtain", "upper_arm_link", "forearms", 0.5)]
+    assert root_cause(same[0]) == root_cause(same[1]) == ("bay-curtain", "upper limbs")
+    assert root_cause(klass("bay-curtain", "forearm_link", "chest", 0.0)) == ("bay-curtain", "trunk")
+    assert root_cause(klass("none", "forearm_link", "hands", 0.0)) != root_cause(same[0])

@@ -63,8 +63,10 @@ def test_result_file_contents(sims, tmp_path) -> None:
     res = search(sim, "mcts", budget=200, seed=0, top_k=5)
     doc = json.loads(res.write(tmp_path).read_text())
     assert set(doc) == {"cell", "searcher", "params", "seed", "budget", "until", "found", "episodes", "hazard",
-                        "hazards", "top", "risk_per_episode", "version", "format"}
-    assert doc["cell"] == {"name": "s3-fence-gap", "sha256": sim.cell.sha256, "source": "s3-fence-gap"}
+                        "hazards", "top", "risk_per_episode", "distinct_sequences", "version", "format"}
+    assert doc["cell"] == {"name": "s3-fence-gap", "sha256": sim.cell.sha256, "source": "s3-fence-gap",
+                           "criterion": "contact-while-moving"}
+    assert 1 <= doc["distinct_sequences"] <= doc["episodes"]
     assert doc["searcher"] == "mcts" and doc["params"] == {"ec": 0.5, "k": 1.0, "alpha": 0.85}
     assert doc["version"] == cellstress.__version__
     assert len(doc["top"]) == min(5, doc["episodes"])

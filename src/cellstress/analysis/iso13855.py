@@ -99,8 +99,8 @@ class ApproachCheck:
     undetected_area: float  # m^2 of floor the worker's centre reaches undetected
     lean: float  # m, largest horizontal hip-to-shoulder distance of the body model
     arm_allowance: float  # m
-    scanner_margin: float  # m, the centre may come this close to a scanner field undetected
-    curtain_margin: float  # m, ... to a light curtain
+    scanner_margin: float | None  # m, the centre may come this close to a scanner field undetected (None: none)
+    curtain_margin: float | None  # m, ... to a light curtain (None: the cell has none)
     stand: tuple[float, float] | None  # standing point of the closest reach
     distance: float  # m, shortest arm path from an undetected shoulder position to the zone (inf: none)
     where: Closest | None
@@ -260,16 +260,17 @@ def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowan
         ok &= ~points_in_polygon(X, Y, poly) & (distance_to_polyline(X, Y, poly, True) >= radius)
     for a, b in _walk_blocking_fences(spec):
         ok &= point_segment(X, Y, a[0], a[1], b[0], b[1])[0] >= radius
-    m_scan, m_curtain = 0.0, 0.0
+    m_scan: float | None = None
+    m_curtain: float | None = None
     curtains = []
     for prim in (p for d in spec.devices for p in d.primitives()):
         if isinstance(prim, ScanPlane):
             m = detection_margin(body, prim.height, prim.height)
-            m_scan = max(m_scan, m)
+            m_scan = m if m_scan is None else max(m_scan, m)
             ok &= ~points_in_polygon(X, Y, prim.polygon) & (distance_to_polyline(X, Y, prim.polygon, True) > m)
         else:
             m = detection_margin(body, prim.bottom, prim.top)
-            m_curtain = max(m_curtain, m)
+            m_curtain = m if m_curtain is None else max(m_curtain, m)
             ok &= point_segment(X, Y, prim.start[0], prim.start[1], prim.end[0], prim.end[1])[0] > m
             curtains.append((tuple(prim.start), tuple(prim.end)))
     sx, sy = spec.human.start.xy
@@ -384,8 +385,10 @@ def _lines(r: StaticCheck) -> list[str]:
     for p in open_:
         out.append(f"  panel {_xy(p.start)}-{_xy(p.end)} counts as open: {p.reason}")
     a = r.approach
-    head = (f"undetected reach from {_xy(a.start)}: stand >{a.scanner_margin:.2f} m from scanner fields and "
-            f">{a.curtain_margin:.2f} m from curtains ({a.undetected_area:.1f} m^2), lean {a.lean:.3f} m, "
+    margins = [f">{m:.2f} m from {what}" for m, what in ((a.scanner_margin, "scanner fields"),
+                                                         (a.curtain_margin, "curtains")) if m is not None]
+    where = f"stand {' and '.join(margins)}" if margins else "no detection zone to keep away from"
+    head = (f"undetected reach from {_xy(a.start)}: {where} ({a.undetected_area:.1f} m^2), lean {a.lean:.3f} m, "
             f"arm {a.arm_allowance:.2f} m")
     out.append(head)
     if a.start_detected:

@@ -73,7 +73,8 @@ class RunWriter:
 
     def __init__(self, path: Path):
         self.path = path
-        self._fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+        # O_NOFOLLOW: a symbolic link planted at runs.jsonl must not redirect the appends to its target
+        self._fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o666)
 
     def append(self, record: dict[str, Any]) -> None:
         data = (json_line(record) + "\n").encode("utf-8")
@@ -107,7 +108,8 @@ class FolderLock:
             import fcntl
         except ImportError:  # not on POSIX: no lock, as before
             return self
-        self._f = open(self.path, "a")  # noqa: SIM115 - held open for the lock's lifetime
+        fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o666)
+        self._f = os.fdopen(fd, "a")  # held open for the lock's lifetime
         try:
             fcntl.flock(self._f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:

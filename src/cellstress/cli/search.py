@@ -75,6 +75,7 @@ def search(
     from cellstress.searchers import make_searcher, parse_options
     from cellstress.searchers import search as run
     from cellstress.searchers.common import check_common
+    from cellstress.searchers.distinct import link_group, root_cause
     from cellstress.sim.simulator import Simulator
 
     options = {name: v for name, v in (("ec", ec), ("k", k), ("alpha", alpha), ("n", n)) if v is not None}
@@ -155,11 +156,19 @@ def search(
         if h.verdict is not None:  # a criterion that judges contacts: its account of this one
             name, numbers = h.verdict
             echo(f"{name:<9} {numbers.get('reason')}")
+    causes: dict[tuple[str, str], list[int]] = {}
     for i, d in enumerate(result.distinct or ()):
-        cls = d.klass
-        x0, y0, x1, y1 = cls.approach_cell
-        echo(f"class {i}   episode {d.episode}: {cls.device} / {cls.robot_link} / {cls.body_region} at "
-             f"x {num(x0)}..{num(x1)}, y {num(y0)}..{num(y1)}  (cellstress replay {path} --hazard {i})")
+        causes.setdefault(root_cause(d.klass), []).append(i)
+    for n, ((device, area), members) in enumerate(causes.items(), start=1):
+        failed = "no device saw the worker" if device == "none" else f"{device} stopped the robot too late"
+        echo(f"cause {n}   {failed}; {area} touched ({len(members)} {'class' if len(members) == 1 else 'classes'})")
+        for i in members:
+            d = result.distinct[i]
+            cls = d.klass
+            x0, y0, x1, y1 = cls.approach_cell
+            echo(f"  class {i}  episode {d.episode}: {cls.robot_link} ({link_group(sim.layout, cls.robot_link)}) / "
+                 f"{cls.body_region}, worker at x {num(x0)}..{num(x1)}, y {num(y0)}..{num(y1)}  "
+                 f"(cellstress replay {path} --hazard {i})")
     if report:
         echo(report)
     echo(f"wrote     {path}")

@@ -21,6 +21,11 @@ class CriterionRecord(Record):
     distance_tolerance: Annotated[float, Field(ge=0.0, le=0.1)] = 0.0
     speed_tolerance: Annotated[float, Field(ge=0.0, le=0.1)] = 0.001
 
+    def describe(self) -> str:
+        """What this criterion calls unsafe, in one sentence; a criterion kind says it better by overriding."""
+        return (f"unsafe as the {getattr(self, 'type', type(self).__name__)} criterion judges a contact (contact: "
+                f"d_HR <= {self.distance_tolerance:g} m; the robot moves: v_R > {self.speed_tolerance:g} m/s)")
+
 
 def safety_index(d_hr: float, v_r: float) -> float:
     """The paper's safety index c_S = (d_HR^2 + 1) exp(-v_R): large when safe."""

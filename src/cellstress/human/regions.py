@@ -64,3 +64,18 @@ def body_region(part: int, point, pose: BodyPose, height: float, upper_arm: floa
             return "upper-arms"
         return "forearms" if dist < upper_arm + forearm else "hands"
     return "hands" if dist >= upper_arm + forearm else "forearms"
+
+
+# ISO/TS 15066's regions gathered into the body areas a safety engineer groups findings by (its Table A.2 lists
+# them under the same headings: head with face and neck; trunk; upper limbs; lower limbs)
+REGION_GROUPS = {
+    "skull-forehead": "head", "face": "head", "neck": "head",
+    "back-shoulders": "trunk", "chest": "trunk", "abdomen": "trunk", "pelvis": "trunk",
+    "upper-arms": "upper limbs", "forearms": "upper limbs", "hands": "upper limbs",
+    "thighs": "lower limbs", "lower-legs": "lower limbs",
+}
+
+
+def region_group(region: str) -> str:
+    """The body area (head, trunk, upper limbs, lower limbs) of an ISO/TS 15066 region."""
+    return REGION_GROUPS.get(region, region)

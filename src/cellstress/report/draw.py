@@ -201,6 +201,15 @@ def draw_plan(ax, layout: Layout, style: PlanStyle = PlanStyle(), robot_tau: flo
         s = spec.human.start
         draw_pose_arrow(ax, s.xy[0], s.xy[1], np.deg2rad(s.heading_deg), START, size=style.start_size, zorder=8)
         handles.append(Line2D([], [], marker=">", ms=9, color=START, ls="none", label="worker start and heading"))
+        for named in spec.human.starts:  # a search picks one of these per episode
+            x, y = named.xy
+            draw_pose_arrow(ax, x, y, np.deg2rad(named.heading_deg), START, size=style.start_size, zorder=8,
+                            alpha=0.6)
+            ax.annotate(named.name, (x, y), xytext=(0, -11), textcoords="offset points", fontsize=7,
+                        ha="center", color="#1a6b1a", zorder=8)
+        if spec.human.starts:
+            handles.append(Line2D([], [], marker=">", ms=9, color=START, alpha=0.6, ls="none",
+                                  label="named start points"))
     ax.set_aspect("equal")
     ax.set_xlim(fl.xmin - 0.1, fl.xmax + 0.1)
     ax.set_ylim(fl.ymin - 0.1, fl.ymax + 0.1)

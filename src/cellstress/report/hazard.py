@@ -4,6 +4,7 @@ contact seen from above and from the side, and the search's risk per episode.
 
 from __future__ import annotations
 
+import math
 import textwrap
 from dataclasses import dataclass
 
@@ -11,6 +12,7 @@ import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 
+from cellstress.analysis.iso13855 import StaticCheck
 from cellstress.report import draw as D
 from cellstress.report.episode import EpisodeView
 from cellstress.sim.build import Layout
@@ -38,15 +40,68 @@ def _legend(fig, ax, handles) -> None:
               borderaxespad=0.0)
 
 
-def layout_figure(layout: Layout, size: D.FigureSize = StillOptions().layout, title: str | None = None):
-    """The cell alone (``cellstress show``): returns (figure, axes)."""
+def layout_figure(layout: Layout, size: D.FigureSize = StillOptions().layout, title: str | None = None,
+                  static: StaticCheck | None = None):
+    """The cell alone (``cellstress show``): returns (figure, axes). With ``static`` (the cell's ISO 13855 check)
+    each device's distance is drawn as a dimension line from where a worker enters its detection zone to the
+    hazard zone, labelled with the distance the standard requires and the one the layout gives."""
     fig = D.new_figure(size)
     ax = fig.add_axes(PLAN_AXES)
     handles = D.draw_plan(ax, layout)
     spec = layout.cell.spec
+    if static is not None:
+        handles += _draw_distances(ax, static)
     ax.set_title(title or f"{spec.name}: cell layout (top view, metres)", fontsize=11, loc="left")
     _legend(fig, ax, handles)
     return fig, ax
+
+
+def _draw_distances(ax, static: StaticCheck) -> list:
+    """ISO 13855 dimension lines: green where the layout gives the required distance S, red where it does not;
+    the closest undetected reach (ISO 13857) likewise."""
+    lines = [(d.where, f"{d.device}: S {d.required:.2f} m needed, {d.actual:.2f} m here", d.ok)
+             for d in static.devices if d.where is not None]
+    a = static.approach
+    if a.where is not None and math.isfinite(a.distance):
+        lines.append((a.where, f"reach around: {a.distance:.2f} m, {a.arm_allowance:.2f} m needed", a.ok))
+    placed: list[tuple[float, float]] = []
+    for where, text, ok in lines:
+        color = OK_COLOR if ok else FAIL_COLOR
+        (x0, y0), (x1, y1) = where.point, where.hazard_point
+        ax.annotate("", (x1, y1), xytext=(x0, y0), arrowprops=dict(arrowstyle="<|-|>", color=color, lw=1.4),
+                    zorder=15)
+        # two dimension lines may end at the same place (a scanner's open edge and the reach around it): their
+        # labels go one under the other
+        lx, ly = (x0 + x1) / 2 + 0.08, (y0 + y1) / 2
+        while any(abs(ly - py) < 0.2 and abs(lx - px) < 2.0 for px, py in placed):
+            ly -= 0.2
+        placed.append((lx, ly))
+        ax.annotate(text, (lx, ly), fontsize=7, color=color, zorder=16, va="center",
+                    bbox=dict(boxstyle="round,pad=0.15", facecolor="white", edgecolor="none", alpha=0.8))
+    if not lines:
+        return []
+    return [Line2D([], [], color=OK_COLOR, lw=1.4, label="ISO 13855 / 13857 distance met"),
+            Line2D([], [], color=FAIL_COLOR, lw=1.4, label="distance not met (check fails)")]
+
+
+OK_COLOR, FAIL_COLOR = "#2ca02c", "#d62728"
+
+# where an action's label may go, in units of the pose mark, tried in this order (right, then left, above, below)
+LABEL_SPOTS = ((0.35, 0.1), (0.35, -0.9), (-1.5, 0.1), (-1.5, -0.9), (0.35, 1.1), (-1.5, 1.1), (0.35, -1.9),
+               (-1.5, -1.9), (0.35, 2.1), (-1.5, 2.1), (1.6, 0.1), (-2.7, 0.1))
+
+
+def _free_spot(x: float, y: float, placed: list[tuple[float, float]], mark: float) -> tuple[float, float]:
+    """The first of ``LABEL_SPOTS`` around (x, y) whose label box (about 1.2 x 0.85 marks, the size of a
+    two-character label at the mark sizes we draw) overlaps no label placed before; it is then placed. Labels of
+    actions that end close together (turning in place, a blocked walk) would otherwise print over each other."""
+    w, h = 1.2 * mark, 0.85 * mark
+    for dx, dy in LABEL_SPOTS:
+        lx, ly = x + dx * mark, y + dy * mark
+        if all(abs(lx - px) >= w or abs(ly - py) >= h for px, py in placed):
+            break
+    placed.append((lx, ly))
+    return lx, ly
 
 
 def _draw_episode(ax, view: EpisodeView, pose, reach: list[np.ndarray], handles: list | None,
@@ -61,16 +116,13 @@ def _draw_episode(ax, view: EpisodeView, pose, reach: list[np.ndarray], handles:
     ax.plot(xy[:, 0], xy[:, 1], color=D.PATH, lw=1.6, zorder=9)
     ax.plot(xy[:, 0], xy[:, 1], ".", color=D.PATH, ms=3, zorder=9)
     add(Line2D([], [], color=D.PATH, lw=1.6, marker=".", ms=3, label=f"worker's path ({view.dt:g} s steps)"))
-    placed: dict[tuple[int, int], int] = {}
+    placed: list[tuple[float, float]] = []
     for k, act in enumerate(view.actions):
         r = recs[view.action_rows(k)[-1]]
         D.draw_pose_arrow(ax, r.x, r.y, np.deg2rad(r.heading_deg), "white", size=mark_size, zorder=13)
-        # actions ending at the same spot (turning in place, blocked) get their labels stacked, not overprinted
-        spot = (round(r.x / 0.1), round(r.y / 0.1))
-        above = placed.get(spot, 0)
-        placed[spot] = above + 1
-        ax.annotate(f"{k + 1}{POSTURE_MARK.get(act.partition('+')[2], '?')}", (r.x, r.y),
-                    xytext=(6, 4 + 8 * above), textcoords="offset points", fontsize=7, color="#0b3c6b", zorder=14)
+        x, y = _free_spot(r.x, r.y, placed, mark_size)
+        ax.annotate(f"{k + 1}{POSTURE_MARK.get(act.partition('+')[2], '?')}", (r.x, r.y), xytext=(x, y),
+                    textcoords="data", fontsize=7, color="#0b3c6b", zorder=14, va="bottom", ha="left")
     add(Line2D([], [], marker=">", color="white", mec="black", ls="none", ms=7,
                label="after action k: heading, posture\n(U upright, F forward, L / R left / right)"))
     ax.add_collection(D.capsule_patches(pose.a[:, :2], pose.b[:, :2], pose.r, facecolor=D.BODY, alpha=0.7,

@@ -7,6 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from cellstress.analysis.iso13855 import check_cell
 from cellstress.core.errors import CellstressError
 from cellstress.report import draw as D
 from cellstress.report import html as H
@@ -210,12 +211,12 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
 
 @D.plain_text
 def show_cell(cell, out: str | Path, size: D.FigureSize | None = None) -> Path:
-    """Draw a cell's layout (``cellstress show``) into a PNG file."""
+    """Draw a cell's layout (``cellstress show``) into a PNG file, with the static check's distances."""
     from cellstress.cell.load import load_cell
     from cellstress.report.hazard import layout_figure
     from cellstress.sim.build import build_layout
 
     c = cell if not isinstance(cell, (str, Path)) else load_cell(cell)
     layout = build_layout(c)
-    fig, _ = layout_figure(layout, size or StillOptions().layout)
+    fig, _ = layout_figure(layout, size or StillOptions().layout, static=check_cell(c, layout))
     return D.save_png(fig, out)

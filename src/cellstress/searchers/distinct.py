@@ -10,6 +10,11 @@
 * approach cell: the 0.5 m floor cell under the worker at the unsafe step (``floor(x / 0.5), floor(y / 0.5)``),
   so the same flaw reached from two sides of the cell is two classes, but small changes of posture are not.
 
+**Root causes.** Classes are fine-grained on purpose (the search steers away from each); for people they are
+grouped by root cause (``root_cause``: the safeguard that failed and the body area), so one curtain standing
+too close reads as one cause with several classes (links, hand or forearm, floor cells), not as several
+findings.
+
 **Moving on.** Once a class is found, reaching it again earns no hazard reward: the unsafe end is rewarded as a
 safe end of the episode would be (the terminal penalty), both for new episodes (``DistinctReward``) and for the
 tree nodes that already led there (their cached reward is lowered when the tree comes back to them, so the
@@ -22,7 +27,7 @@ import math
 
 from cellstress.core.protocols import StartChoices
 from cellstress.core.records import Measures
-from cellstress.human.regions import body_region
+from cellstress.human.regions import body_region, region_group
 from cellstress.searchers.common import Recorder, Stop
 from cellstress.searchers.result import HazardClass
 from cellstress.sim.layout import M_FWD, M_HEADING, M_HX, M_HZ, M_LAT, M_LINK, M_PART, M_X, M_Y, S_TRIG_DEV
@@ -41,6 +46,24 @@ def hazard_class(sim, state, row) -> tuple:
     b = lay.body
     region = body_region(int(row[M_PART]), row[M_HX:M_HZ + 1], pose, b.height, b.upper_arm, b.forearm)
     return (device, link, region, math.floor(row[M_X] / CELL_SIZE), math.floor(row[M_Y] / CELL_SIZE))
+
+
+def link_group(layout, link: str) -> str:
+    """Where along the robot's chain a link sits: ``base side``, ``middle`` or ``wrist and tool`` (thirds of the
+    chain by the joint a capsule rides on), so that one flaw hit by the forearm in one episode and by the
+    upper arm in the next is one root cause, on any serial robot."""
+    joints = {c.name: c.joint for c in layout.capsules}
+    n = max(layout.robot.n_joints, 1)
+    j = joints.get(link, -1) + 1  # 0: the base, n: the last joint
+    third = 3 * j / (n + 1)
+    return "base side" if third < 1 else "middle" if third < 2 else "wrist and tool"
+
+
+def root_cause(klass: HazardClass) -> tuple[str, str]:
+    """A distinct class's root cause: the safeguard that failed (``none``: no device saw the worker) and the body
+    area touched. Classes that share it differ only in detail (the robot link and where along the chain it sits,
+    hand or forearm, where the worker stood); ``cellstress search --distinct`` lists them under their cause."""
+    return klass.device, region_group(klass.body_region)
 
 
 def hazard_class_record(key: tuple) -> HazardClass:
