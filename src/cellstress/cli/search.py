@@ -27,6 +27,9 @@ def _searcher_help() -> str:
             "evolve and plan are ours; see docs/results.md).")
 
 
+COMPILING = "compiling the simulator (first run only; numba caches it)"
+
+
 def _params_text(params: dict) -> str:
     return ", ".join(f"{k} {'auto' if v is None else num(v) if isinstance(v, float) else v}"
                      for k, v in params.items())
@@ -67,7 +70,7 @@ def search(
     import time
 
     from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
     from cellstress.cell.load import load_cell, with_criterion
     from cellstress.cli.report import after_search
@@ -76,6 +79,7 @@ def search(
     from cellstress.searchers import search as run
     from cellstress.searchers.common import check_common
     from cellstress.searchers.distinct import link_group, root_cause
+    from cellstress.sim.compiling import watching
     from cellstress.sim.simulator import Simulator
 
     options = {name: v for name, v in (("ec", ec), ("k", k), ("alpha", alpha), ("n", n)) if v is not None}
@@ -91,37 +95,46 @@ def search(
         if distinct and until != "budget":
             raise CellstressError("--distinct needs --until budget")
     out_dir = check_out_dir(out)
-    with user_errors():
-        sim = Simulator(with_criterion(load_cell(cell), criterion))
 
     console = Console(stderr=True)
-    progress = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+    progress = Progress(SpinnerColumn(), TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
                         TextColumn("{task.fields[rate]:>7.0f} episodes/s  best risk {task.fields[risk]:.3f}"),
                         TimeElapsedColumn(), console=console, transient=True,
                         disable=not console.is_terminal)
-    task = progress.add_task(searcher, total=budget, rate=0.0, risk=0.0)
-    t0 = time.perf_counter()
+    task = progress.add_task("loading the cell", total=budget, rate=0.0, risk=0.0)
+
+    def compiling(active: bool) -> None:
+        progress.update(task, description=COMPILING if active else searcher)
 
     played = [0]
+    t0 = time.perf_counter()
 
     def tick(done: int, best_risk: float) -> None:
         played[0] = done
         if done % 8 == 0 or done == budget:
-            progress.update(task, completed=done, rate=done / max(time.perf_counter() - t0, 1e-9), risk=best_risk)
+            busy = time.perf_counter() - t0 - watch.seconds
+            progress.update(task, completed=done, rate=done / max(busy, 1e-9), risk=best_risk)
 
     try:
-        with progress, user_errors():
+        with watching(compiling) as watch, progress, user_errors():
+            sim = Simulator(with_criterion(load_cell(cell), criterion))
+            progress.update(task, description=searcher)
+            setup = watch.seconds
+            t0 = time.perf_counter()
             result = run(sim, searcher, budget, seed, until=until, top_k=top_k, progress=tick, distinct=distinct,
                          **options)
     except KeyboardInterrupt:
         say(f"interrupted after {played[0]} of {budget} episodes; nothing was written to {out_dir} (a search "
             "is replayable only whole: run the same command again)", err=True)
         raise typer.Exit(INTERRUPTED) from None
-    elapsed = time.perf_counter() - t0
+    compiled = watch.seconds
+    elapsed = time.perf_counter() - t0 - (compiled - setup)  # the search's own time, without compiling
     try:
         path = result.write(out_dir)
     except OSError as exc:
         raise fail(f"--out {out}: cannot write result.json ({exc.strerror or exc})") from None
+    if compiled >= 1.0:
+        say(f"compiled  the simulator's kernels in {compiled:.0f} s (once: numba keeps them in its cache)", err=True)
     rate = result.episodes / max(elapsed, 1e-9)
     report = None if no_report else after_search(path, sim)
     if as_json:
