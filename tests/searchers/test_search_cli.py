@@ -114,6 +114,16 @@ def test_replay_recomputes_every_claim(plan_result, tmp_path, capsys, field, val
     assert mismatches and named in mismatches[0], out
 
 
+def test_replay_of_a_file_from_before_the_criterion_and_sequence_count(plan_result, tmp_path, capsys) -> None:
+    """Files written before result.json named its criterion and counted distinct sequences make no claim about
+    them: they still replay."""
+    doc = json.loads(json.dumps(plan_result))
+    del doc["distinct_sequences"], doc["cell"]["criterion"]
+    (tmp_path / "result.json").write_text(json.dumps(doc))
+    code, out, _ = _run(["replay", str(tmp_path / "result.json")], capsys)
+    assert code == 0 and "REPRODUCED bit-exactly" in out, out
+
+
 def test_replay_unforged_and_no_search(plan_result, tmp_path, capsys) -> None:
     (tmp_path / "result.json").write_text(json.dumps(plan_result))
     code, out, _ = _run(["replay", str(tmp_path / "result.json")], capsys)

@@ -86,6 +86,11 @@ def _search_again(res: SearchResult, sim: Simulator) -> list[str]:
         return [f"searcher, params: the recorded search cannot be run again ({exc})"]
     recorded, rerun = res.to_dict(), again.to_dict()
     recorded.pop("version"), rerun.pop("version")
+    # files written before these fields existed make no claim about them
+    if "distinct_sequences" not in recorded:
+        rerun.pop("distinct_sequences", None)
+    if "criterion" not in recorded["cell"]:
+        rerun["cell"].pop("criterion", None)
     found = differences(recorded, rerun, "")
     if not found:
         return []

@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from cellstress.cli.common import CELL_HELP, first_sentence, num, say, user_errors
+from cellstress.cli.common import CELL_HELP, first_sentence, num, say, spinner_while_compiling, user_errors
 
 
 def check(
@@ -24,7 +24,7 @@ def check(
     from cellstress.robot.model import load_robot, resolve_urdf
     from cellstress.robot.trajectory import build_trajectory
 
-    with user_errors():
+    with spinner_while_compiling(), user_errors():
         c = load_cell(cell)
         spec = c.spec
         urdf = resolve_urdf(spec.robot.urdf, c.directory)

@@ -30,6 +30,32 @@ def say(text: str = "", *, err: bool = False, nl: bool = True) -> None:
     typer.echo("\n".join(for_terminal(line) for line in str(text).split("\n")), err=err, nl=nl)
 
 
+COMPILING = "compiling the simulator (first run only; numba caches it)"
+
+
+@contextmanager
+def spinner_while_compiling() -> Iterator[None]:
+    """A spinner on a terminal's stderr while numba compiles kernels (a fresh installation's first run), so a
+    long silent wait is never a mystery; nothing otherwise. Imported lazily: ``--help`` must not load numba."""
+    from rich.console import Console
+
+    from cellstress.sim.compiling import watching
+
+    console = Console(stderr=True)
+    status = console.status(COMPILING) if console.is_terminal else None
+
+    def show(active: bool) -> None:
+        if status is not None:
+            status.start() if active else status.stop()
+
+    try:
+        with watching(show):
+            yield
+    finally:
+        if status is not None:
+            status.stop()
+
+
 def fail(message: str) -> typer.Exit:
     """Print ``error: message`` as one line on stderr; the caller raises the returned Exit(2)."""
     one_line = " ".join(str(message).split())

@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from cellstress.cli.common import HEADER, num, say, step_line, user_errors
+from cellstress.cli.common import HEADER, num, say, spinner_while_compiling, step_line, user_errors
 
 
 def replay(
@@ -27,7 +27,7 @@ def replay(
     from cellstress.core.io import json_ready
     from cellstress.searchers.result import SearchResult
 
-    with user_errors():
+    with spinner_while_compiling(), user_errors():
         res = SearchResult.load(result_file)
         check = check_result(res, hazard_index, search_again=not no_search)
     say(HEADER)

@@ -10,7 +10,7 @@ from typing import Annotated
 
 import typer
 
-from cellstress.cli.common import fail, say
+from cellstress.cli.common import fail, say, spinner_while_compiling
 from cellstress.core.errors import CellstressError
 from cellstress.core.text import slug
 
@@ -25,7 +25,8 @@ def report(
     from cellstress.report.make import write_report
 
     try:
-        files = write_report(result_file)
+        with spinner_while_compiling():
+            files = write_report(result_file)
     except CellstressError as exc:
         raise fail(str(exc)) from None
     except OSError as exc:
@@ -59,7 +60,8 @@ def show(
     try:
         if path.parent != Path(""):
             path.parent.mkdir(parents=True, exist_ok=True)
-        show_cell(c, path)
+        with spinner_while_compiling():
+            show_cell(c, path)
     except CellstressError as exc:
         raise fail(str(exc)) from None
     except OSError as exc:

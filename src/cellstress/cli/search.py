@@ -8,6 +8,7 @@ import typer
 
 from cellstress.cli.common import (
     CELL_HELP,
+    COMPILING,
     INTERRUPTED,
     check_criterion,
     check_out_dir,
@@ -25,9 +26,6 @@ def _searcher_help() -> str:
 
     return (f"One of {', '.join(registry.names('searchers'))} (mcts is the paper's MCTS1, mcts-commit its MCTS2; "
             "evolve and plan are ours; see docs/results.md).")
-
-
-COMPILING = "compiling the simulator (first run only; numba caches it)"
 
 
 def _params_text(params: dict) -> str:

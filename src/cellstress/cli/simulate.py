@@ -7,7 +7,17 @@ from typing import Annotated
 
 import typer
 
-from cellstress.cli.common import CELL_HELP, HEADER, check_criterion, criterion_help, num, say, step_line, user_errors
+from cellstress.cli.common import (
+    CELL_HELP,
+    HEADER,
+    check_criterion,
+    criterion_help,
+    num,
+    say,
+    spinner_while_compiling,
+    step_line,
+    user_errors,
+)
 
 
 def simulate(
@@ -28,7 +38,7 @@ def simulate(
 
     with user_errors("--actions: "):
         indices = parse_actions(actions)
-    with user_errors():
+    with spinner_while_compiling(), user_errors():
         check_criterion(criterion)
         c = with_criterion(load_cell(cell), criterion)
         sim = Simulator(c)
