@@ -13,14 +13,18 @@ from cellstress.sim.layout import M_D, M_V, NM, S_K, S_UNSAFE
 
 BATCH_CHUNK = 32  # episodes per work-array set in run_batch
 
+# Integer constants handed to the non-inlined step kernels are np.int64(...): numba types a bare constant as a
+# literal and compiles the callee once more for it (a cold start spent ~28 s on a second sense_and_measure and
+# ~28 s on two more step_actions that way).
+
 
 @njit(cache=True, error_model="numpy")
 def run_episode(P, s0, actions, out):
     """Play ``actions`` from s0; out[0] is the initial row. Returns the number of rows written."""
     W = make_work(P)
     state = s0.copy()
-    sense_and_measure(P, state, W, out[0], -1)
-    n = 1
+    sense_and_measure(P, state, W, out[0], np.int64(-1))
+    n = np.int64(1)
     for a in range(actions.shape[0]):
         n += step_action(P, state, actions[a], W, out, n)
         if state[S_UNSAFE] != 0.0:
@@ -37,7 +41,7 @@ def _batch_episode(P, s0, actions, e, W, state, rows, d_end, v_end, unsafe_step,
     unsafe_step[e] = -1
     lo = np.inf
     for k in range(n_act):
-        n = step_action(P, state, actions[e, k], W, rows, 0)
+        n = step_action(P, state, actions[e, k], W, rows, np.int64(0))
         for i in range(n):
             if rows[i, M_D] < lo:
                 lo = rows[i, M_D]
@@ -83,4 +87,4 @@ def make_handle(P, W):
 def step_with_handle(h, state, action, out):
     """step_action(P, state, action, W, out, 0) for the (P, W) in handle h."""
     P, W = h[0]
-    return step_action(P, state, action, W, out, 0)
+    return step_action(P, state, action, W, out, np.int64(0))

@@ -16,6 +16,10 @@ from cellstress.sim.layout import B_ARM_LEN, C_REACH_H, C_REACH_ORIGIN
 
 TRACE_REL_TOL = 0.05  # far from contact, d_HR needs only relative accuracy (it feeds a smooth reward)
 
+# The non-inlined fence kernels get n_near as np.int64(n_near): sense_and_measure's fence-free branch passes the
+# constant 0 (so that this code drops out of it), and numba would compile each of them once more for that literal,
+# a version never called (~10 s of a cold start).
+
 
 @njit(cache=True, error_model="numpy", inline="always")
 def reach_field_at(reach, origin, h, sh, tr, side, px, py, pz):
@@ -32,7 +36,7 @@ def reach_field_at(reach, origin, h, sh, tr, side, px, py, pz):
 def fenced_reach(arm_len, fences, near, sh, side, n_near, f, px, py, pz, cutoff):
     """The reach value ``f`` raised where the near fence panels make the hand go the long way round; exact
     below ``cutoff``, and at least ``cutoff`` otherwise."""
-    g = fence_detour(fences, near, n_near, sh[side, 0], sh[side, 1], sh[side, 2], px, py, pz,
+    g = fence_detour(fences, near, np.int64(n_near), sh[side, 0], sh[side, 1], sh[side, 2], px, py, pz,
                      cutoff + arm_len) - arm_len
     return g if g > f else f
 
@@ -66,7 +70,7 @@ def reach_to_segment(reach, origin, h, arm_len, fences, near, sh, tr, side, n_ne
     t = 0.0
     # Does the axis pass through a near panel? (Not for a robot inside its fence; if it does, the detour's
     # bound may drop there faster than the axis moves, and the trace below does not lean on that bound.)
-    through = n_near > 0 and blocking_panel(fences, near, n_near, ax, ay, az, bx, by, bz) >= 0
+    through = n_near > 0 and blocking_panel(fences, near, np.int64(n_near), ax, ay, az, bx, by, bz) >= 0
     sx, sy, sz = sh[side, 0], sh[side, 1], sh[side, 2]
     while True:
         tt = t / L if L > 0.0 else 0.0
@@ -79,7 +83,8 @@ def reach_to_segment(reach, origin, h, arm_len, fences, near, sh, tr, side, n_ne
         # Nor does its exact value from bound + r + h up: it is no new best then, and the steps below use
         # only its lower bound there.
         if n_near > 0 and fl < best and fl < bound + r:
-            g, g_lb = fence_detour_bound(fences, near, n_near, sx, sy, sz, px, py, pz, bound + r + h + arm_len)
+            g, g_lb = fence_detour_bound(fences, near, np.int64(n_near), sx, sy, sz, px, py, pz,
+                                          bound + r + h + arm_len)
             g -= arm_len
             g_lb -= arm_len
             f = g if g > f else f

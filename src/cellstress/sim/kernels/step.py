@@ -112,7 +112,7 @@ def reset_state(P, x, y, heading, state, W, row):
     state[S_TSTOP] = np.inf
     state[S_TRIG_DEV] = -1.0
     state[S_TRIG_T] = -1.0
-    sense_and_measure(P, state, W, row, -1)
+    sense_and_measure(P, state, W, row, np.int64(-1))  # not a literal: see batch.py
 
 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
