@@ -91,8 +91,8 @@ def test_no_random_no_ratio_and_unknown_pairs_have_no_paper_numbers():
 
 
 def _plan() -> CampaignPlan:
-    return CampaignPlan((CellRef(CELL, CELL, "0" * 64),), (SearcherRef("random", ()), SearcherRef("mcts", ())),
-                        4, 200, "0")
+    return CampaignPlan((CellRef(CELL, CELL, "0" * 64, "contact-while-moving: unsafe when touched"),),
+                        (SearcherRef("random", ()), SearcherRef("mcts", ())), 4, 200, "0")
 
 
 def test_markdown_and_csv_rows():
@@ -104,6 +104,7 @@ def test_markdown_and_csv_rows():
     assert ("| s1-scanner-width | random | 2/4 | 0.50 (0.15–0.85) | 120.0 (1.0–200.0) | 130.0 | 1.00 | 3/10 "
             "| 166.8 | 1.00 |") in lines
     assert "Huck" in md and "Wilson" in md and "Student-t" in md
+    assert f"Criterion of {CELL}: contact-while-moving: unsafe when touched." in lines
     table = list(csv.DictReader(io.StringIO(csv_text(rows))))
     assert table[1]["searcher"] == "mcts"
     assert float(table[1]["mean_episodes"]) == 25.0 and float(table[1]["ratio_to_random"]) == pytest.approx(0.208333)

@@ -4,6 +4,7 @@ Chromium; tells the hazard in words (or says that none was found)."""
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 from html.parser import HTMLParser
@@ -63,6 +64,7 @@ def test_html_tells_the_hazard(s3_report):
     for action in h["actions"]:
         assert action in text  # the action table
     assert "agrees bit-exactly" in text
+    assert "Judged by contact-while-moving: unsafe when the worker touches the robot" in text
 
 
 def test_account_of_a_detected_worker(s1_witness_view):
@@ -84,6 +86,8 @@ def test_account_of_a_detected_worker(s1_witness_view):
 def test_no_hazard_report(safe_report):
     text = " ".join(_parse(safe_report / "report.html").text)
     assert "No hazard found" in text and "riskiest episode" in text
+    assert "judged by contact-while-moving" in text and "A search is not a proof" in text
+    assert re.search(r"Searched: \d+ episodes of up to 8 actions \(\d+ different action sequences\)", text)
     for name in ("topview.png", "contact.png", "replay.gif", "risk.png"):
         with Image.open(safe_report / name) as img:
             assert float(np.asarray(img.convert("L"), float).std()) > 8.0

@@ -50,6 +50,8 @@ class CellRef:
     name: str
     source: str
     sha256: str
+    # what the cell calls unsafe, in words (its file, pinned by sha256, fixes it: not part of the manifest)
+    criterion: str = ""
 
 
 @dataclass(frozen=True)
@@ -154,7 +156,7 @@ def resolve(cells: tuple[str, ...], searchers: tuple[str, ...], seeds: int, budg
             raise CampaignError(f"--cells: {exc}") from None
         # a file by its absolute path, so that workers (and a resume from another folder) find it
         source = ref if ref in BUILTIN_CELLS else str(Path(ref).expanduser().resolve())
-        refs.append(CellRef(c.name, source, c.sha256))
+        refs.append(CellRef(c.name, source, c.sha256, f"{c.spec.criterion.type}: {c.spec.criterion.describe()}"))
     names = [r.name for r in refs]
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:

@@ -142,6 +142,16 @@ def _f(x: float | None, digits: int) -> str:
     return "–" if x is None else f"{x:.{digits}f}"
 
 
+def _criteria(plan: CampaignPlan) -> list[str]:
+    """A line per criterion: which cells it judged and what it calls unsafe (each cell's own criterion)."""
+    by: dict[str, list[str]] = {}
+    for c in plan.cells:
+        if c.criterion:
+            by.setdefault(c.criterion, []).append(c.name)
+    return [f"Criterion of {', '.join(for_markdown(n) for n in names)}: {for_markdown(text)}.\n"
+            for text, names in by.items()]
+
+
 def markdown(rows: list[Row], plan: CampaignPlan) -> str:
     seeds = f"seeds 0–{plan.seeds - 1}" if plan.seeds > 1 else "seed 0"
     lines = [
@@ -153,6 +163,7 @@ def markdown(rows: list[Row], plan: CampaignPlan) -> str:
         f"[1, {plan.budget}]. Ratio: the mean over random's mean in the same cell. "
         f"Paper (at its budget, {paper_table().budget}, only): {paper_table().citation}",
         "",
+        *_criteria(plan),
         "| cell | searcher | found | success rate (95 % CI) | mean episodes (95 % CI) | median | mean / random "
         "| paper found | paper mean | paper mean / random |",
         "|---|---|---:|---|---|---:|---:|---:|---:|---:|",

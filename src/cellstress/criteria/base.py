@@ -24,7 +24,7 @@ class CriterionRecord(Record):
     def describe(self) -> str:
         """What this criterion calls unsafe, in one sentence; a criterion kind says it better by overriding."""
         return (f"unsafe as the {getattr(self, 'type', type(self).__name__)} criterion judges a contact (contact: "
-                f"d_HR <= {self.distance_tolerance:g} m; the robot moves: v_R > {self.speed_tolerance:g} m/s)")
+                f"d_HR at most {self.distance_tolerance:g} m; the robot moves: v_R above {self.speed_tolerance:g} m/s)")
 
 
 def safety_index(d_hr: float, v_r: float) -> float:

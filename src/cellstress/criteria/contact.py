@@ -45,8 +45,8 @@ class ContactWhileMoving(CriterionRecord):
     type: Literal["contact-while-moving"] = "contact-while-moving"
 
     def describe(self) -> str:
-        return (f"unsafe when the worker touches the robot (d_HR <= {self.distance_tolerance:g} m) while it moves "
-                f"(v_R > {self.speed_tolerance:g} m/s), whatever the force (the paper's criterion)")
+        return (f"unsafe when the worker touches the robot (d_HR at most {self.distance_tolerance:g} m) while it "
+                f"moves (v_R above {self.speed_tolerance:g} m/s), whatever the force (the paper's criterion)")
 
     def is_unsafe(self, d_hr: float, v_r: float) -> bool:
         return d_hr <= self.distance_tolerance and v_r > self.speed_tolerance
