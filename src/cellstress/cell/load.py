@@ -46,6 +46,11 @@ def _builtin_path(name: str):
     return resources.files("cellstress.cell").joinpath("builtin").joinpath(f"{name}.yaml")
 
 
+def builtin_file(name: str) -> str:
+    """Where a built-in cell's file is (to read it as an example, or copy it as a start)."""
+    return str(_builtin_path(name))
+
+
 def builtin_text(name: str) -> str:
     """The YAML text of a built-in cell; CellError when its file is missing from the installation."""
     path = _builtin_path(name)

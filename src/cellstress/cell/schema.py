@@ -50,17 +50,25 @@ JointAngle = Annotated[float, Field(ge=-3600.0, le=3600.0, allow_inf_nan=False)]
 
 
 class Pose(Record):
+    """Where the robot's base frame is in the cell."""
+
     xyz: Point3 = (0.0, 0.0, 0.0)
+    """Position of the base frame's origin [m]."""
     yaw_deg: Angle = 0.0
+    """Rotation about the vertical axis [deg], counter-clockwise seen from above."""
 
 
 class CapsuleSpec(Record):
     """A capsule fixed to a robot link, in that link's frame."""
 
     link: Name
+    """The URDF link the capsule moves with."""
     p0: Point3
+    """One end of the capsule's axis, in the link's frame [m]."""
     p1: Point3
+    """The other end [m]."""
     radius: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)]
+    """Radius [m]."""
 
 
 class TaskSpec(Record):
@@ -68,9 +76,13 @@ class TaskSpec(Record):
 
     waypoints_deg: tuple[Annotated[tuple[JointAngle, ...], Field(max_length=MAX_JOINTS)], ...] = \
         Field(min_length=2, max_length=MAX_WAYPOINTS)
+    """Joint angles [deg] of each waypoint, one per revolute joint of the URDF, within its joint limits."""
     dwell: Annotated[float, Field(ge=0.0, le=60.0, allow_inf_nan=False)] = 0.2
+    """Pause at each waypoint [s]."""
     speed_scale: Annotated[float, Field(ge=0.01, le=1.0, allow_inf_nan=False)] = 0.5
+    """Fraction of the joints' velocity limits used between waypoints (minimum-jerk moves)."""
     phase: Annotated[float, Field(ge=0.0, le=3600.0, allow_inf_nan=False)] = 0.0
+    """The robot's time in its cycle [s] when an episode starts: the moment at which the worker arrives."""
 
     @field_validator("waypoints_deg")
     @classmethod
@@ -97,25 +109,41 @@ CapsulesField = Annotated[
 
 
 class RobotSpec(Record):
+    """The robot: a serial chain from a URDF, placed in the cell, with its collision capsules and its program."""
+
     urdf: Annotated[str, Field(min_length=1, max_length=1000, pattern=r"^[^\x00]+$")] = "ur10"
+    """A robot of example-robot-data by its short name (ur10) or the path of a URDF file, relative to the cell
+    file."""
     base: Pose = Pose()
+    """The base frame in the cell."""
     capsules: CapsulesField = "auto"
+    """The collision capsules: auto (fitted to the URDF's collision meshes) or a list."""
     extra_capsules: tuple[CapsuleSpec, ...] = Field((), max_length=MAX_CAPSULES)
+    """Capsules added to the robot's own, e.g. a gripper holding a part."""
     stopping_time: PositiveTime = 0.15
+    """Time [s] from the stop signal to standstill, braking along the path."""
     task: TaskSpec
+    """The robot's cyclic program."""
 
 
 class TableSpec(Record):
+    """The work table: the worker cannot walk into it, and bends over it."""
+
     height: Height = 0.85
+    """Height of the table top [m]."""
     polygons: tuple[Polygon, ...] = Field(min_length=1, max_length=MAX_COUNT)
+    """Outlines of the table top [m], each a simple polygon of at most 256 points."""
 
 
 class FenceSpec(Record):
     """A run of fence panels along a polyline, from ``bottom`` to ``top`` above the floor."""
 
     points: tuple[Point2, ...] = Field(min_length=2, max_length=MAX_VERTICES)
+    """The polyline on the floor [m]; each segment is a panel."""
     top: Height = 2.0
+    """Height of the panels' top edge [m] (ISO 13857: below 1 m a fence is no barrier to reaching)."""
     bottom: Elevation = 0.0
+    """Height of the panels' bottom edge [m] (a gap under a panel lets a hand through)."""
 
     @model_validator(mode="after")
     def _heights(self) -> FenceSpec:
@@ -131,9 +159,13 @@ class FloorSpec(Record):
     """The walkable rectangle: the worker cannot leave it."""
 
     xmin: Coordinate
+    """Left edge [m]."""
     xmax: Coordinate
+    """Right edge [m]."""
     ymin: Coordinate
+    """Lower (back) edge [m]."""
     ymax: Coordinate
+    """Upper (front) edge [m]."""
 
     @model_validator(mode="after")
     def _ordered(self) -> FloorSpec:
@@ -171,31 +203,46 @@ class Anthropometry(Record):
     percentile woman to above the 95th percentile man (stature about 1.52 to 1.87 m; docs/cells.md)."""
 
     height: Annotated[float, Field(ge=1.4, le=2.1, allow_inf_nan=False)] = 1.78
+    """Stature [m]; the body's capsules scale with it (Winter's segment proportions)."""
     upper_arm: Annotated[float, Field(ge=0.2, le=0.45, allow_inf_nan=False)] = 0.30
+    """Upper arm length [m]."""
     forearm: Annotated[float, Field(ge=0.18, le=0.40, allow_inf_nan=False)] = 0.31
+    """Forearm length [m]."""
     hand: Annotated[float, Field(ge=0.12, le=0.25, allow_inf_nan=False)] = 0.18
+    """Hand length [m]."""
 
 
 class StartSpec(Record):
+    """Where the worker stands when an episode starts."""
+
     xy: Point2
+    """Position on the floor [m]: not inside the table, a fence or the robot's base."""
     heading_deg: Angle
+    """Direction the worker faces [deg], counter-clockwise from +x."""
 
 
 class NamedStart(StartSpec):
     name: Annotated[str, Field(min_length=1, max_length=100, pattern=r"^[A-Za-z0-9_.-]+$")]
-    # the robot's path time [s] when a worker from this start point begins (the moment of the cycle at which
-    # they arrive); None: the cell's robot.task.phase
+    """The start point's name (letters, digits, ``. _ -``): an episode's actions begin with ``start:NAME``."""
     phase: Annotated[float, Field(ge=0.0, le=3600.0, allow_inf_nan=False)] | None = None
+    """The robot's time in its cycle [s] when a worker from here arrives; absent: robot.task.phase."""
 
 
 class HumanSpec(Record):
+    """The worker: where they start, their body and how they move (the paper's 30 actions)."""
+
     start: StartSpec
-    # the start points a search chooses from, one per episode (its first decision); empty: ``start`` only
+    """The worker's start pose."""
     starts: tuple[NamedStart, ...] = Field((), max_length=MAX_COUNT)
+    """Start points a search chooses from, one per episode (its first decision); empty: ``start`` only."""
     anthropometry: Anthropometry = Anthropometry()
+    """Body dimensions."""
     walking_speed: Annotated[float, Field(ge=0.1, le=3.0, allow_inf_nan=False)] = 1.6
+    """Walking speed [m/s] (ISO 13855's approach speed)."""
     max_forward_flexion_deg: Annotated[float, Field(ge=0.0, le=90.0)] = 55.0
+    """The largest forward bend of the trunk [deg]."""
     max_lateral_flexion_deg: Annotated[float, Field(ge=0.0, le=60.0)] = 35.0
+    """The largest sideways bend of the trunk [deg]."""
 
     @field_validator("starts")
     @classmethod
@@ -208,22 +255,40 @@ class HumanSpec(Record):
 
 
 class SimulationSpec(Record):
+    """The simulation's clock and the length of an episode."""
+
     dt: Annotated[float, Field(ge=0.001, le=1.0, allow_inf_nan=False)] = 0.05
+    """Time step [s]."""
     steps_per_action: Annotated[int, Field(ge=1, le=100)] = 4
+    """Time steps per worker action (4 x 0.05 s = 0.2 s, the paper's)."""
     actions_per_episode: Annotated[int, Field(ge=1, le=100)] = 8
+    """Actions per episode (the paper's 8)."""
 
 
 class CellSpec(Record):
+    """A robot cell: the robot and its program, the table, fences, floor, safety devices, the worker and the
+    criterion that says what is unsafe."""
+
     name: Name
+    """The cell's name, shown in outputs (printable, one line)."""
     description: Annotated[str, Field(max_length=10_000)] = ""
+    """Free text; its first sentence is shown by ``cellstress cells`` and ``check``."""
     robot: RobotSpec
+    """The robot."""
     table: TableSpec
+    """The work table."""
     fences: tuple[FenceSpec, ...] = Field((), max_length=MAX_PANELS)
+    """Fences, each a polyline of panels (at most 1,024 panels in all)."""
     floor: FloorSpec
+    """The walkable floor."""
     devices: tuple[DeviceSpec, ...] = Field((), max_length=MAX_COUNT)
+    """Safety devices, each tagged by its ``type`` (the kinds installed: see below); names unique."""
     human: HumanSpec
+    """The worker."""
     criterion: CriterionSpec = Field(default_factory=lambda: registry.load("criteria", DEFAULT_CRITERION)())
+    """What is unsafe, tagged by its ``type``; absent: contact-while-moving (the paper's)."""
     simulation: SimulationSpec = SimulationSpec()
+    """Time step and episode length."""
 
     @field_validator("devices")
     @classmethod

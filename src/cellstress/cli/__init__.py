@@ -14,8 +14,10 @@ from cellstress.cli.campaign import campaign
 from cellstress.cli.cells import cells
 from cellstress.cli.check import check
 from cellstress.cli.common import USER_ERROR, fail
+from cellstress.cli.new import new
 from cellstress.cli.replay import replay
 from cellstress.cli.report import report, show
+from cellstress.cli.schema import schema
 from cellstress.cli.search import search
 from cellstress.cli.simulate import simulate
 from cellstress.core.errors import CellstressError
@@ -27,7 +29,7 @@ app = typer.Typer(
     rich_markup_mode=None,
     help="Find hidden human-robot hazards in industrial robot cells.",
 )
-for command in (cells, check, simulate, search, replay, campaign, report, show):
+for command in (cells, check, simulate, search, replay, campaign, report, show, schema, new):
     app.command()(command)
 
 

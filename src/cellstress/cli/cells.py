@@ -7,10 +7,12 @@ from cellstress.core.errors import CellstressError
 
 
 def cells() -> None:
-    """List the built-in cells with the first sentence of each description."""
+    """List the built-in cells with the first sentence of each description, and where their files are."""
+    import os
+
     import yaml
 
-    from cellstress.cell.load import BUILTIN_CELLS, builtin_text
+    from cellstress.cell.load import BUILTIN_CELLS, builtin_file, builtin_text
 
     width = max(len(n) for n in BUILTIN_CELLS)
     for name in BUILTIN_CELLS:
@@ -24,3 +26,5 @@ def cells() -> None:
             continue
         description = data.get("description", "") if isinstance(data, dict) else ""
         say(f"{name:<{width}}  {first_sentence(str(description or '')) or '(no description)'}")
+    say(f"files in {os.path.dirname(builtin_file(BUILTIN_CELLS[0]))} (NAME.yaml; docs/cell-format.md describes "
+        "every field, 'cellstress new NAME' writes a starter cell)")

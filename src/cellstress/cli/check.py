@@ -19,7 +19,7 @@ def check(
     import numpy as np
 
     from cellstress.analysis.iso13855 import check_cell
-    from cellstress.cell.load import BUILTIN_CELLS, load_cell
+    from cellstress.cell.load import BUILTIN_CELLS, builtin_file, load_cell
     from cellstress.robot.capsules import declared_capsule, fitted_capsules
     from cellstress.robot.model import load_robot, resolve_urdf
     from cellstress.robot.trajectory import build_trajectory
@@ -44,8 +44,8 @@ def check(
         static = check_cell(c)
 
     out = say
-    origin = "built-in" if cell in BUILTIN_CELLS else "file"
-    out(f"cell        {spec.name}  ({origin}: {c.source}, sha256 {c.sha256[:12]})")
+    where = f"built-in: {builtin_file(cell)}" if cell in BUILTIN_CELLS else f"file: {c.source}"
+    out(f"cell        {spec.name}  ({where}, sha256 {c.sha256[:12]})")
     if spec.description:
         out(f"            {first_sentence(spec.description)}")
     base = spec.robot.base

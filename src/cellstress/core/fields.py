@@ -38,7 +38,8 @@ Name = Annotated[str, Field(min_length=1, max_length=100, pattern=PRINTABLE)]
 class Record(BaseModel):
     """A frozen file record: unknown fields are an error (a misspelt field must not be silently ignored)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # a string right under a field is its description: docs/cell-format.md and `cellstress schema` show it
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
 
 
 def _segments_cross(a: Point2, b: Point2, c: Point2, d: Point2) -> bool:

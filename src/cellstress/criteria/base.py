@@ -19,7 +19,9 @@ class CriterionRecord(Record):
     a completed stop is a standstill)."""
 
     distance_tolerance: Annotated[float, Field(ge=0.0, le=0.1)] = 0.0
+    """A contact is d_HR at or below this [m]."""
     speed_tolerance: Annotated[float, Field(ge=0.0, le=0.1)] = 0.001
+    """The robot moves when v_R is above this [m/s] (the float residue of a completed stop is a standstill)."""
 
     def describe(self) -> str:
         """What this criterion calls unsafe, in one sentence; a criterion kind says it better by overriding."""

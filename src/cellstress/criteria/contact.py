@@ -43,6 +43,7 @@ class MovingContact:
 
 class ContactWhileMoving(CriterionRecord):
     type: Literal["contact-while-moving"] = "contact-while-moving"
+    """No contact unless the robot stands still (the paper's unsafe set)."""
 
     def describe(self) -> str:
         return (f"unsafe when the worker touches the robot (d_HR at most {self.distance_tolerance:g} m) while it "

@@ -101,7 +101,9 @@ class Iso15066(CriterionRecord):
     """``payload`` [kg] is added to the robot's reflected mass (see docs/criteria.md)."""
 
     type: Literal["iso15066"] = "iso15066"
+    """A contact is unsafe when its estimated force exceeds the ISO/TS 15066 transient limit of its body region."""
     payload: Annotated[float, Field(ge=0.0, le=1000.0)] = 2.0
+    """Mass [kg] added to the robot's reflected mass (tool and part)."""
 
     def describe(self) -> str:
         return ("unsafe when a contact's estimated peak force exceeds the ISO/TS 15066 transient limit of the body "

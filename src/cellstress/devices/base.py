@@ -10,4 +10,6 @@ class DeviceRecord(Record):
     name in cell files and in the ``cellstress.devices`` registry) and the ``core.protocols.Device`` methods."""
 
     name: Name
+    """The device's name, shown in outputs; unique in the cell."""
     response_time: PositiveTime
+    """Time [s] from detection to the stop signal."""

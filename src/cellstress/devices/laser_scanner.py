@@ -22,9 +22,13 @@ class LaserScanner(DeviceRecord):
     ``response_time`` [s] from detection to the stop signal."""
 
     type: Literal["laser-scanner"]
+    """A horizontal laser scanner's protective field."""
     polygon: Polygon
+    """The protective field's outline on the floor [m]."""
     height: Annotated[float, Field(ge=0.0, le=1.0)] = 0.3
+    """Height of the scan plane above the floor [m]; it sees what crosses the plane inside the field."""
     response_time: PositiveTime = 0.35
+    """Time [s] from detection to the stop signal."""
 
     detection_phrase: ClassVar[str] = "walks into the field of the laser scanner"
     color: ClassVar[str] = "#f2c300"

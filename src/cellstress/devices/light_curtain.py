@@ -43,12 +43,19 @@ class LightCurtain(DeviceRecord):
     ``resolution_mm``: detection capability d; ``response_time`` [s]."""
 
     type: Literal["light-curtain"]
+    """A vertical light curtain across an opening."""
     start: Point2
+    """One end of the curtain's line on the floor [m]."""
     end: Point2
+    """The other end [m]."""
     bottom: Elevation = 0.2
+    """Height of the lowest beam [m]."""
     top: Height = 1.8
+    """Height of the highest beam [m]."""
     response_time: PositiveTime = 0.05
+    """Time [s] from detection to the stop signal."""
     resolution_mm: Annotated[float, Field(gt=0.0, le=200.0)] = 30.0
+    """Detection capability d [mm] (ISO 13855: the reach-through allowance C grows with it)."""
 
     detection_phrase: ClassVar[str] = "breaks the light curtain"
     color: ClassVar[str] = "#7b2cbf"
