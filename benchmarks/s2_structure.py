@@ -1,6 +1,6 @@
 """Why S2's hazard resists guided search: its structure, counted by playing sequences (issue 4, part 6).
 
-    python benchmarks/s2_structure.py [--cell s2-elbow-intrusion] [--episodes 100000] [--seed 5]
+    python benchmarks/s2_structure.py [--cell s2-deceptive] [--episodes 100000] [--seed 5]
 
 1. **Every 4-action sequence** (30^4 = 810,000) is played from the cell's start with ``run_batch``, padded to
    8 actions with ``turn-left-45+upright`` (the simulator is causal, so the padding cannot change anything up
@@ -86,7 +86,7 @@ def without_devices(cell: str, tmp: Path) -> Path:
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--cell", default="s2-elbow-intrusion")
+    ap.add_argument("--cell", default="s2-deceptive")
     ap.add_argument("--episodes", type=int, default=100_000)
     ap.add_argument("--seed", type=int, default=5)
     args = ap.parse_args()

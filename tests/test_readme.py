@@ -61,4 +61,4 @@ def test_python_examples(capsys):
             exec(compile(body, "README.md", "exec"), {})
     printed = capsys.readouterr().out.split()
     assert printed[:2] == ["True", "75"]
-    assert printed[2:5] == ["0.7", "forearm_link", "left-reach"]  # the S2 witness (docs/cells.md)
+    assert printed[2:5] == ["0.6", "upper_arm_link", "left-reach"]  # the S2 witness (docs/cells.md)

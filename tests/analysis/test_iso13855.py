@@ -14,7 +14,7 @@ from cellstress.analysis import iso13855 as iso
 from cellstress.analysis import plane
 from cellstress.cell.load import builtin_text, load_cell
 
-CELLS = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap")
+CELLS = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap", "s2-deceptive")
 
 
 # ---- body numbers used by the check -----------------------------------------------------------------------
@@ -89,8 +89,9 @@ def test_s1_fails_only_the_scanner(results):
     assert r.devices[0].actual < 1.88
 
 
-def test_s2_fails_only_the_curtain(results):
-    r = results["s2-elbow-intrusion"][1]
+@pytest.mark.parametrize("cell", ["s2-elbow-intrusion", "s2-deceptive"])  # same robot and path, other phases
+def test_s2_fails_only_the_curtain(results, cell):
+    r = results[cell][1]
     assert r.failures() == ["bay-curtain"]
     curtain = r.devices[1]
     assert curtain.actual == pytest.approx(0.985, abs=0.005) and curtain.actual < 1.17

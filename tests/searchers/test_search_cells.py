@@ -112,7 +112,9 @@ def test_budget_is_exact_on_a_safe_cell(budget) -> None:
 
 def test_random_batch_and_stepping_agree(sims) -> None:
     """The random searcher plays chunks with run_batch; stepping the same episodes gives the same outcome."""
-    sim = sims["s2-elbow-intrusion"]
+    from cellstress.sim.simulator import Simulator
+
+    sim = Simulator("s2-deceptive")  # seed 5 finds its hazard within 300 episodes
 
     class Stepping:  # the simulator without its BatchSimulator ability
         def __init__(self):

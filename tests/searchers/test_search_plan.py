@@ -101,7 +101,7 @@ def without_devices(name: str, tmp_path) -> Simulator:
     return Simulator(path)
 
 
-@pytest.mark.parametrize("cell", ["s2-elbow-intrusion", "s3-fence-gap"])
+@pytest.mark.parametrize("cell", ["s2-deceptive", "s3-fence-gap"])
 def test_robot_points_learned_in_one_episode_hold_in_every_other(cell, tmp_path) -> None:
     """The premise of the model: until a stop, the robot's pose is a function of time alone. In a cell without
     devices nothing stops the robot, so a predicted clearance is an upper bound on the real d_HR of any sequence

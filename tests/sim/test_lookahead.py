@@ -13,9 +13,9 @@ from cellstress.sim import layout as L
 from cellstress.sim.lookahead import Lookahead, default_horizon
 from cellstress.sim.simulator import Simulator
 
-# an S2 hazard (curtain crossed, elbow touched while braking) and an S1 walk into the scanner field
+# an S2 hazard (s2-deceptive: curtain crossed, elbow touched while braking) and an S1 walk into the scanner field
 EPISODES = {
-    "s2-elbow-intrusion": ["walk+upright", "walk+upright", "turn-right-45+bend-right", "walk+bend-left"],
+    "s2-deceptive": ["walk+upright", "walk+upright", "turn-right-45+bend-right", "walk+bend-left"],
     "s1-scanner-width": ["walk+upright", "walk+bend-forward", "walk+upright", "turn-left-45+upright",
                          "walk+bend-forward", "walk+upright"],
 }
@@ -61,12 +61,12 @@ def test_gaps_match_brute_force(cell) -> None:
             break
     # the episodes cover the running robot and a requested stop
     assert L.PHASE_RUNNING in phases and phases - {L.PHASE_RUNNING}
-    if cell == "s2-elbow-intrusion":
+    if cell == "s2-deceptive":
         assert sim.is_unsafe(state)
 
 
 def test_zero_window_is_d_hr_of_the_moving_robot() -> None:
-    sim = Simulator("s2-elbow-intrusion")
+    sim = Simulator("s2-deceptive")  # these actions touch the rebuilt S2's elbow
     la = Lookahead(sim.params, horizon=0.0, speed=1.6)
     state = sim.reset()
     rows_all, gaps = [], []

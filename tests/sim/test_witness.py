@@ -11,8 +11,10 @@ WITNESSES = {
     # cell: (actions, unsafe time step, robot link, body part, devices that saw the worker at contact)
     "s1-scanner-width": ("walk+bend-left,walk+bend-left,walk+bend-forward,walk+bend-forward-right",
                          15, "wrist_2_link", "left-reach", ["front-scanner"]),
-    "s2-elbow-intrusion": ("walk+bend-right,walk+bend-left,turn-right-45+upright,walk+bend-forward-left",
-                           14, "forearm_link", "left-reach", ["bay-curtain"]),
+    "s2-elbow-intrusion": ("walk+upright,walk+bend-left,walk+bend-forward",
+                           12, "upper_arm_link", "left-reach", ["bay-curtain"]),
+    "s2-deceptive": ("walk+bend-right,walk+bend-left,turn-right-45+upright,walk+bend-forward-left",
+                     14, "forearm_link", "left-reach", ["bay-curtain"]),
     "s3-fence-gap": ("walk+bend-right,turn-left-45+bend-forward-left,walk+bend-forward,walk+bend-forward-left",
                      15, "forearm_link", "left-reach", []),
 }

@@ -25,7 +25,8 @@ from cellstress.human.body import BODY_RADIUS, WALK_BLOCK_HEIGHT
 from cellstress.robot.model import load_robot, resolve_urdf
 from cellstress.robot.trajectory import build_trajectory
 
-BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap", "all-flaws")
+BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap", "all-flaws",
+                                  "s2-deceptive")
 
 
 @dataclass(frozen=True)
