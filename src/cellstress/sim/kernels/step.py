@@ -82,13 +82,10 @@ def sense_and_measure(P, state, W, row, action):
     cap_r, reach, origin, grid_h, arm_len, fences = P.cap_r, P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], \
         P.body[B_ARM_LEN], P.fences
     ra, rb, near, lbs, ts, q = W.ra, W.rb, W.near, W.lbs, W.ts, W.best_r
-    if n_near == 0:
-        # the common case, compiled separately so that the fence-detour code drops out of it
-        d_hr = separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
-                          0, row)
-    else:
-        d_hr = separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
-                          n_near, row)
+    # One inlined copy of separation: a second, fence-free copy (n_near the constant 0) cost ~10 s of a cold
+    # compile for no measurable speed (the fence code is skipped by a branch on n_near either way).
+    d_hr = separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
+                      n_near, row)
     unsafe = d_hr <= P.scal[C_DTOL] and v > P.scal[C_VTOL]
     row[M_T] = t
     row[M_X], row[M_Y], row[M_HEADING] = state[S_X], state[S_Y], state[S_HEADING]
@@ -127,7 +124,8 @@ def step_action(P, state, action, W, out, row0):
     h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
     n = 0
     for j in range(1, spa + 1):
-        move_worker(P, state, action, h0, f0, l0, j / spa, W)
+        move_worker(P.act, P.scal, P.body, P.fences, P.floor, P.table_verts, P.table_poly, state, action, h0, f0, l0,
+                    j / spa, W.ha, W.hb, W.hr, W.sh, W.tr)
         state[S_K] += 1.0
         unsafe = sense_and_measure(P, state, W, out[row0 + n], action)
         n += 1
@@ -137,20 +135,21 @@ def step_action(P, state, action, W, out, row0):
     return n
 
 
-@njit(cache=True, error_model="numpy", inline="always")
-def move_worker(P, state, action, h0, f0, l0, frac, W):
+# Not inlined (compiled once, shared by step_action and worker_paths; ~N s less of a cold compile). It takes
+# the arrays it reads rather than SimParams and Work: see the package docstring.
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def move_worker(act, scal, body, fences, floor, table_verts, table_poly, state, action, h0, f0, l0, frac,
+                ha, hb, hr, sh, tr):
     """The worker's own motion over one time step of ``action`` (begun at heading h0 and posture f0, l0):
     ``frac`` of the action done. It depends on the actions and the fixed layout only, never on the robot."""
-    walks = P.act[action, 0]
-    body, fences, floor, table_verts, table_poly = P.body, P.fences, P.floor, P.table_verts, P.table_poly
-    ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
+    walks = act[action, 0]
     x, y = state[S_X], state[S_Y]
-    h = h0 + P.act[action, 1] * frac
-    f = f0 + (P.act[action, 2] - f0) * frac
-    lt = l0 + (P.act[action, 3] - l0) * frac
+    h = h0 + act[action, 1] * frac
+    f = f0 + (act[action, 2] - f0) * frac
+    lt = l0 + (act[action, 3] - l0) * frac
     nx, ny = x, y
     if walks != 0.0:
-        stride = body[B_WALK_SPEED] * P.scal[C_DT]
+        stride = body[B_WALK_SPEED] * scal[C_DT]
         nx, ny = x + stride * np.cos(h), y + stride * np.sin(h)
         if not feet_ok(body[B_BODY_RADIUS], floor, table_verts, table_poly, fences, nx, ny):
             nx, ny = x, y
@@ -178,7 +177,8 @@ def worker_paths(P, s0, actions, W, out):
         for a in range(actions.shape[1]):
             h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
             for j in range(1, spa + 1):
-                move_worker(P, state, actions[e, a], h0, f0, l0, j / spa, W)
+                move_worker(P.act, P.scal, P.body, P.fences, P.floor, P.table_verts, P.table_poly, state,
+                            actions[e, a], h0, f0, l0, j / spa, W.ha, W.hb, W.hr, W.sh, W.tr)
                 out[e, k, 0], out[e, k, 1], out[e, k, 2] = state[S_X], state[S_Y], state[S_HEADING]
                 out[e, k, 3], out[e, k, 4] = state[S_FWD], state[S_LAT]
                 k += 1
