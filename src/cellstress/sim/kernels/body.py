@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from cellstress.sim.geometry import NO_REFCOUNT
 from cellstress.sim.layout import (
     B_ARM_LEN,
     B_HEAD_RISE,
@@ -27,8 +26,7 @@ def human_pose(P, x, y, heading, fwd, lat, W):
     pose_body(P.body, x, y, heading, fwd, lat, W.ha, W.hb, W.hr, W.sh, W.tr)
 
 
-# Not inlined: five call sites (two in move_worker) share one compiled copy.
-@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+@njit(cache=True, error_model="numpy", inline="always")
 def pose_body(b, x, y, heading, fwd, lat, ha, hb, hr, sh, tr):
     """human_pose on the arrays themselves (the hot path: see the module docstring)."""
     ch, shh = np.cos(heading), np.sin(heading)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from cellstress.sim.geometry import NO_REFCOUNT, segment_segment_xyz
+from cellstress.sim.geometry import segment_segment_xyz
 from cellstress.sim.kernels.reach import fenced_reach, reach_field_at, reach_to_segment
 from cellstress.sim.layout import (
     M_D,
@@ -27,9 +27,7 @@ def _set_reach_hit(row, q):
     row[M_RX], row[M_RY], row[M_RZ] = q[0], q[1], q[2]
 
 
-# Not inlined: compiled once (its callers in sense_and_measure, the lookahead and the probe share it), which
-# cut N s of a cold compile. It takes arrays, not SimParams and Work, and allocates nothing (NO_REFCOUNT).
-@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+@njit(cache=True, error_model="numpy", inline="always")
 def separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
                n_near, row):
     """d_HR: minimum distance between the robot capsules and the body capsules or reach volumes.

@@ -82,7 +82,7 @@ def sense_and_measure(P, state, W, row, action):
     cap_r, reach, origin, grid_h, arm_len, fences = P.cap_r, P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], \
         P.body[B_ARM_LEN], P.fences
     ra, rb, near, lbs, ts, q = W.ra, W.rb, W.near, W.lbs, W.ts, W.best_r
-    # One inlined copy of separation: a second, fence-free copy (n_near the constant 0) cost ~10 s of a cold
+    # One inlined copy of separation: a second, fence-free copy (n_near the constant 0) cost ~8 s of a cold
     # compile for no measurable speed (the fence code is skipped by a branch on n_near either way).
     d_hr = separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
                       n_near, row)
@@ -124,8 +124,7 @@ def step_action(P, state, action, W, out, row0):
     h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
     n = 0
     for j in range(1, spa + 1):
-        move_worker(P.act, P.scal, P.body, P.fences, P.floor, P.table_verts, P.table_poly, state, action, h0, f0, l0,
-                    j / spa, W.ha, W.hb, W.hr, W.sh, W.tr)
+        move_worker(P, state, action, h0, f0, l0, j / spa, W)
         state[S_K] += 1.0
         unsafe = sense_and_measure(P, state, W, out[row0 + n], action)
         n += 1
@@ -135,32 +134,33 @@ def step_action(P, state, action, W, out, row0):
     return n
 
 
-# Not inlined (compiled once, shared by step_action and worker_paths; ~N s less of a cold compile). It takes
-# the arrays it reads rather than SimParams and Work: see the package docstring.
-@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
-def move_worker(act, scal, body, fences, floor, table_verts, table_poly, state, action, h0, f0, l0, frac,
-                ha, hb, hr, sh, tr):
+@njit(cache=True, error_model="numpy", inline="always")
+def move_worker(P, state, action, h0, f0, l0, frac, W):
     """The worker's own motion over one time step of ``action`` (begun at heading h0 and posture f0, l0):
     ``frac`` of the action done. It depends on the actions and the fixed layout only, never on the robot."""
-    walks = act[action, 0]
+    walks = P.act[action, 0]
+    body, fences, floor, table_verts, table_poly = P.body, P.fences, P.floor, P.table_verts, P.table_poly
+    ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
     x, y = state[S_X], state[S_Y]
-    h = h0 + act[action, 1] * frac
-    f = f0 + (act[action, 2] - f0) * frac
-    lt = l0 + (act[action, 3] - l0) * frac
+    h = h0 + P.act[action, 1] * frac
+    f = f0 + (P.act[action, 2] - f0) * frac
+    lt = l0 + (P.act[action, 3] - l0) * frac
     nx, ny = x, y
     if walks != 0.0:
-        stride = body[B_WALK_SPEED] * scal[C_DT]
+        stride = body[B_WALK_SPEED] * P.scal[C_DT]
         nx, ny = x + stride * np.cos(h), y + stride * np.sin(h)
         if not feet_ok(body[B_BODY_RADIUS], floor, table_verts, table_poly, fences, nx, ny):
             nx, ny = x, y
-    pose_body(body, nx, ny, h, f, lt, ha, hb, hr, sh, tr)
-    if not trunk_clear(body, fences, ha, hb, hr):
-        # the new posture would put the trunk through a fence: keep the old posture where it stands
-        pose_body(body, nx, ny, state[S_HEADING], state[S_FWD], state[S_LAT], ha, hb, hr, sh, tr)
+    # If the new posture would put the trunk through a fence, keep the old posture where it stands; if that
+    # fails too, stay put. (A loop, so that pose_body and trunk_clear are inlined once, not twice: each
+    # copy cost seconds of a cold compile, in step_action and worker_paths alike.)
+    for attempt in range(2):
+        pose_body(body, nx, ny, h, f, lt, ha, hb, hr, sh, tr)
         if trunk_clear(body, fences, ha, hb, hr):
-            h, f, lt = state[S_HEADING], state[S_FWD], state[S_LAT]
-        else:
-            nx, ny, h, f, lt = x, y, state[S_HEADING], state[S_FWD], state[S_LAT]
+            break
+        h, f, lt = state[S_HEADING], state[S_FWD], state[S_LAT]
+        if attempt == 1:
+            nx, ny = x, y
     state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT] = nx, ny, h, f, lt
 
 
@@ -177,8 +177,7 @@ def worker_paths(P, s0, actions, W, out):
         for a in range(actions.shape[1]):
             h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
             for j in range(1, spa + 1):
-                move_worker(P.act, P.scal, P.body, P.fences, P.floor, P.table_verts, P.table_poly, state,
-                            actions[e, a], h0, f0, l0, j / spa, W.ha, W.hb, W.hr, W.sh, W.tr)
+                move_worker(P, state, actions[e, a], h0, f0, l0, j / spa, W)
                 out[e, k, 0], out[e, k, 1], out[e, k, 2] = state[S_X], state[S_Y], state[S_HEADING]
                 out[e, k, 3], out[e, k, 4] = state[S_FWD], state[S_LAT]
                 k += 1
