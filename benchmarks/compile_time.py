@@ -5,10 +5,10 @@
 Each repeat runs a fresh interpreter with an empty NUMBA_CACHE_DIR (numba's cache for ``cache=True``
 functions goes there instead of ``__pycache__`` when it is set, so nothing is loaded from an earlier run) and
 does what a user's first search does: build a cell, run a batch, one whole episode and one step, and the
-worker-only kernels of the plan searcher. It prints the
-wall time of each stage and, from numba's ``numba:compile`` events, every function that was compiled with its
-own time (excluding the functions compiled inside it) and its time including them. ``--src`` runs another
-checkout's sources (e.g. an older tree from ``git archive``).
+plan searcher's worker-only kernels. It prints the wall time of each stage and, from numba's
+``numba:compile`` events, every function that was compiled with its own time (excluding the functions
+compiled inside it) and its time including them. ``--src`` runs another checkout's sources (e.g. an older
+tree from ``git archive``).
 """
 
 from __future__ import annotations
