@@ -4,10 +4,11 @@
 
 Each repeat runs a fresh interpreter with an empty NUMBA_CACHE_DIR (numba's cache for ``cache=True``
 functions goes there instead of ``__pycache__`` when it is set, so nothing is loaded from an earlier run) and
-does what a user's first search does: build a cell, run a batch, one whole episode and one step. It prints the
-wall time of each stage and, from numba's ``numba:compile`` events, every function that was compiled with its
-own time (excluding the functions compiled inside it) and its time including them. ``--src`` runs another
-checkout's sources (e.g. an older tree from ``git archive``).
+does what a user's first search does: build a cell, run a batch, one whole episode and one step, and the
+plan searcher's worker-only kernels. It prints the wall time of each stage and, from numba's
+``numba:compile`` events, every function that was compiled with its own time (excluding the functions
+compiled inside it) and its time including them. ``--src`` runs another checkout's sources (e.g. an older
+tree from ``git archive``).
 """
 
 from __future__ import annotations
@@ -47,6 +48,8 @@ t = time.perf_counter(); s = Simulator("s3-fence-gap"); stages["Simulator('s3-fe
 t = time.perf_counter(); s.run_batch(np.zeros((4, 8), dtype=np.int64)); stages["run_batch"] = time.perf_counter() - t
 t = time.perf_counter(); s.run(["walk+upright"]); stages["run"] = time.perf_counter() - t
 t = time.perf_counter(); s.step(s.reset(), 0); stages["step"] = time.perf_counter() - t
+t = time.perf_counter(); s.worker_paths(np.zeros((2, 8), dtype=np.int64))
+s.worker_distances(np.zeros((2, 5)), np.zeros((2, 3, 3))); stages["worker (plan)"] = time.perf_counter() - t
 stages["total"] = time.perf_counter() - t0
 print(json.dumps({"stages": stages, "compiled": rows}))
 """

@@ -1,13 +1,15 @@
 """A/B speed of two source trees of cellstress, interleaved in one run (fair on a noisy machine).
 
     python benchmarks/kernel_ab.py OLD_SRC NEW_SRC [--cells baseline s3-fence-gap] [--episodes 20000]
-                                   [--rounds 3] [--step]
+                                   [--rounds 3] [--step | --worker]
 
 OLD_SRC / NEW_SRC are folders holding a ``cellstress`` package (e.g. ``git archive HEAD~3 src | tar -x -C
 /tmp/old`` gives /tmp/old/src). Each measurement is a fresh process with one numba thread timing
 ``run_batch`` (best CPU time of 3 calls after a warm-up); rounds alternate A and B. Prints the median
 episodes/s per tree and cell, and their ratio. ``--step`` times ``Simulator.step`` instead (whole episodes
-stepped from Python, as a tree search does; a tenth of the episodes).
+stepped from Python, as a tree search does; a tenth of the episodes). ``--worker`` times the plan searcher's
+worker-only kernels (``worker_paths`` of a twentieth of the episodes, then ``worker_distances`` to 4 points
+per pose).
 """
 
 from __future__ import annotations
@@ -49,6 +51,23 @@ for _ in range(3):
 print(n / best)
 """
 
+CHILD_WORKER = r"""
+import sys, time, numpy as np
+from cellstress.sim.simulator import Simulator
+sim = Simulator(sys.argv[1]); n = int(sys.argv[2]) // 20
+rng = np.random.default_rng(0)
+acts = rng.integers(0, 30, size=(n, sim.actions_per_episode))
+def play(a):
+    poses = sim.worker_paths(a).reshape(-1, 5)
+    pts = poses[:, None, :3] + rng.normal(0.0, 0.6, size=(len(poses), 4, 3)) + np.array([0.0, 0.0, 1.0])
+    sim.worker_distances(poses, pts)
+play(acts[:50])
+best = float("inf")
+for _ in range(3):
+    t0 = time.process_time(); play(acts); best = min(best, time.process_time() - t0)
+print(n / best)
+"""
+
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -58,18 +77,21 @@ def main(argv=None) -> None:
     ap.add_argument("--episodes", type=int, default=20_000)
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--step", action="store_true", help="time Simulator.step instead of run_batch")
+    ap.add_argument("--worker", action="store_true",
+                    help="time the plan searcher's worker-only kernels (worker_paths, worker_distances)")
     args = ap.parse_args(argv)
     for cell in args.cells:
         rates: dict[str, list[float]] = {args.old: [], args.new: []}
+        child = CHILD_WORKER if args.worker else CHILD_STEP if args.step else CHILD
         for _ in range(args.rounds):
             for tree in (args.old, args.new):
                 env = dict(os.environ, PYTHONPATH=tree, NUMBA_NUM_THREADS="1")
-                out = subprocess.run([sys.executable, "-c", CHILD_STEP if args.step else CHILD, cell,
+                out = subprocess.run([sys.executable, "-c", child, cell,
                                       str(args.episodes)], env=env,
                                      capture_output=True, text=True, check=True)
                 rates[tree].append(float(out.stdout.split()[-1]))
         a, b = statistics.median(rates[args.old]), statistics.median(rates[args.new])
-        what = "step" if args.step else "run_batch, one thread"
+        what = "worker kernels" if args.worker else "step" if args.step else "run_batch, one thread"
         print(f"{cell:20s} old {a:9,.0f}  new {b:9,.0f} episodes/s ({what})  new/old {b / a:.2f}"
               f"   (rounds: old {' '.join(f'{r:,.0f}' for r in rates[args.old])};"
               f" new {' '.join(f'{r:,.0f}' for r in rates[args.new])})", flush=True)

@@ -43,7 +43,7 @@ def path_times(rows: np.ndarray) -> np.ndarray:
 @njit(cache=True, error_model="numpy")
 def _detour_within(fences, near, n_near, s, pts, arm_length, keep):
     for i in range(pts.shape[0]):
-        d = K.fence_detour(fences, near, n_near, s[0], s[1], s[2], pts[i, 0], pts[i, 1], pts[i, 2])
+        d = K.fence_detour(fences, near, n_near, s[0], s[1], s[2], pts[i, 0], pts[i, 1], pts[i, 2], np.inf)
         keep[i] = d - arm_length <= 0.0
 
 

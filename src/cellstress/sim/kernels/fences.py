@@ -159,15 +159,17 @@ def _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
     return best, around
 
 
+# A wrapper of fence_detour_bound, not a second inlined copy of _detour_and_bound: that copy cost ~5 s of a
+# cold compile. (cutoff has no default: an omitted argument would be typed apart and compile the callee again.)
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
-def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff=np.inf):
+def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
     """Length of the shortest arm path from shoulder s to q around the near fence panels, over their top
     edge or around their ends (inf if every such path is blocked); |s - q| when nothing is in the way.
 
     A finite ``cutoff`` says that any length from it up will do: the result is exact below it and ``cutoff``
     otherwise, and bends that are not shorter are not checked for crossings (most of the cost). If even the
     way around one of the panels in the way is that long, no bend is looked at."""
-    return _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff)[0]
+    return fence_detour_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff)[0]
 
 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)

@@ -16,9 +16,9 @@ from cellstress.sim.layout import B_ARM_LEN, C_REACH_H, C_REACH_ORIGIN
 
 TRACE_REL_TOL = 0.05  # far from contact, d_HR needs only relative accuracy (it feeds a smooth reward)
 
-# The non-inlined fence kernels get n_near as np.int64(n_near): sense_and_measure's fence-free branch passes the
-# constant 0 (so that this code drops out of it), and numba would compile each of them once more for that literal,
-# a version never called (~10 s of a cold start).
+# The non-inlined fence kernels get n_near as np.int64(n_near): should a caller ever pass a constant (as a
+# fence-free copy of separation once did), numba would type it as a literal and compile each of them once more
+# for it (that cost ~10 s of a cold start).
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from cellstress.sim.geometry import NO_REFCOUNT
 from cellstress.sim.kernels.params import make_work
 from cellstress.sim.layout import (
     C_CYCLE,
@@ -151,7 +152,9 @@ def robot_live(P, t, t_stop, W):
                        P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot, W.pos, W.ra, W.rb, t, t_stop)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+# Not inlined: robot_live (the pre-stop table, pictures) and robot_at (the step, after a stop) share one
+# compiled copy. It takes arrays only and allocates nothing (NO_REFCOUNT).
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def _robot_live(scal, seg_start, seg_move, wp, parents, placements, base, axes, anc, cap_joint, cap_a, cap_b,
                 q, qd, rot, pos, ra, rb, t, t_stop):
     tau, sigma, phase = path_time(scal, t, t_stop)

@@ -82,13 +82,10 @@ def sense_and_measure(P, state, W, row, action):
     cap_r, reach, origin, grid_h, arm_len, fences = P.cap_r, P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], \
         P.body[B_ARM_LEN], P.fences
     ra, rb, near, lbs, ts, q = W.ra, W.rb, W.near, W.lbs, W.ts, W.best_r
-    if n_near == 0:
-        # the common case, compiled separately so that the fence-detour code drops out of it
-        d_hr = separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
-                          0, row)
-    else:
-        d_hr = separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
-                          n_near, row)
+    # One inlined copy of separation: a second, fence-free copy (n_near the constant 0) cost ~8 s of a cold
+    # compile for no measurable speed (the fence code is skipped by a branch on n_near either way).
+    d_hr = separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
+                      n_near, row)
     unsafe = d_hr <= P.scal[C_DTOL] and v > P.scal[C_VTOL]
     row[M_T] = t
     row[M_X], row[M_Y], row[M_HEADING] = state[S_X], state[S_Y], state[S_HEADING]
@@ -154,14 +151,16 @@ def move_worker(P, state, action, h0, f0, l0, frac, W):
         nx, ny = x + stride * np.cos(h), y + stride * np.sin(h)
         if not feet_ok(body[B_BODY_RADIUS], floor, table_verts, table_poly, fences, nx, ny):
             nx, ny = x, y
-    pose_body(body, nx, ny, h, f, lt, ha, hb, hr, sh, tr)
-    if not trunk_clear(body, fences, ha, hb, hr):
-        # the new posture would put the trunk through a fence: keep the old posture where it stands
-        pose_body(body, nx, ny, state[S_HEADING], state[S_FWD], state[S_LAT], ha, hb, hr, sh, tr)
+    # If the new posture would put the trunk through a fence, keep the old posture where it stands; if that
+    # fails too, stay put. (A loop, so that pose_body and trunk_clear are inlined once, not twice: each
+    # copy cost seconds of a cold compile, in step_action and worker_paths alike.)
+    for attempt in range(2):
+        pose_body(body, nx, ny, h, f, lt, ha, hb, hr, sh, tr)
         if trunk_clear(body, fences, ha, hb, hr):
-            h, f, lt = state[S_HEADING], state[S_FWD], state[S_LAT]
-        else:
-            nx, ny, h, f, lt = x, y, state[S_HEADING], state[S_FWD], state[S_LAT]
+            break
+        h, f, lt = state[S_HEADING], state[S_FWD], state[S_LAT]
+        if attempt == 1:
+            nx, ny = x, y
     state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT] = nx, ny, h, f, lt
 
 
