@@ -25,7 +25,7 @@ from cellstress.searchers.common import (
     check_common,
 )
 from cellstress.searchers.distinct import DistinctRecorder, DistinctReward, distinct_problem, hazard_class_record
-from cellstress.searchers.multistart import MultiStartProblem
+from cellstress.searchers.multistart import ArrivalProblem
 from cellstress.searchers.result import (
     FORMAT,
     CellRef,
@@ -127,9 +127,15 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
     reward = sim.criterion.reward(sim.actions_per_episode)
     problem = sim
     names = None
-    if c.spec.human.starts:
-        problem = MultiStartProblem(sim)
+    searched_phase = c.spec.human.arrival != "fixed"
+    if c.spec.human.starts or searched_phase:
+        problem = ArrivalProblem(sim)
         names = problem.names
+    if searched_phase and (type(s).needs or (distinct and type(s).whole_episodes)):
+        raise SearchError(f"searcher {s.name!r}" + (" with --distinct" if not type(s).needs else "")
+                          + " does not choose the arrival phase yet; this cell searches it (human.arrival: "
+                          f"{_arrival_text(c.spec.human.arrival)}): use random, mcts, mcts-commit or evolve, or set "
+                          "human.arrival: fixed")
     rec = None
     missing = [p.__name__ for p in getattr(type(s), "needs", ()) if not isinstance(problem, p)]
     if missing and not (distinct and type(s).whole_episodes):
@@ -179,6 +185,10 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
             distinct_record(sim, hazard_class_record(key), episode, names(actions))
             for key, (episode, actions) in rec.classes.items()),
     )
+
+
+def _arrival_text(arrival) -> str:
+    return arrival if isinstance(arrival, str) else f"{{start: {arrival.start:g}, end: {arrival.end:g}}}"
 
 
 def _unsafe_row(sim: Simulator, actions: list[str]):

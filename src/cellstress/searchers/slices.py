@@ -38,7 +38,7 @@ import numpy as np
 
 from cellstress.searchers.common import Outcome, Recorder, Stop
 from cellstress.searchers.distinct import hazard_class
-from cellstress.searchers.multistart import MultiStartProblem
+from cellstress.searchers.multistart import ArrivalProblem
 
 SLICE_KEY = 7
 SLICE_LEN = 200  # evolve finds S2, the hardest single flaw, within 200 episodes in 166 of 200 seeds (results.md)
@@ -95,7 +95,7 @@ class CellStart:
 def cell_starts(problem, reward) -> list[Start]:
     """The start points of a cell's problem: a ``MultiStartProblem`` (one per ``human.starts`` entry, with
     its first decision's reward) or a ``SimProblem`` (one start, no prefix)."""
-    if not isinstance(problem, MultiStartProblem):
+    if not isinstance(problem, ArrivalProblem):
         return [Start(CellStart(problem))]
     out = []
     for i, sim in enumerate(problem.sims):
