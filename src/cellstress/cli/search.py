@@ -177,8 +177,9 @@ def search(
             d = result.distinct[i]
             cls = d.klass
             x0, y0, x1, y1 = cls.approach_cell
+            move = "" if cls.robot_move is None else f", robot's move {cls.robot_move}"
             echo(f"  class {i}  episode {d.episode}: {cls.robot_link} ({link_group(sim.layout, cls.robot_link)}) / "
-                 f"{cls.body_region}, worker at x {num(x0)}..{num(x1)}, y {num(y0)}..{num(y1)}  "
+                 f"{cls.body_region}, worker at x {num(x0)}..{num(x1)}, y {num(y0)}..{num(y1)}{move}  "
                  f"(cellstress replay {path} --hazard {i})")
     if report:
         echo(report)

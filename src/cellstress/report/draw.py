@@ -242,7 +242,7 @@ def draw_obstacles(ax, layout: Layout) -> list:
                         color=edge, zorder=1.5, annotation_clip=True)
     if tables:
         handles.append(Patch(facecolor=TABLE, edgecolor=TABLE_EDGE, label=f"table ({tables[0].height:g} m)"))
-    if len(tables) < len(layout.obstacles):
+    if any(not _is_table(o) and o.name != PEDESTAL for o in layout.obstacles):
         handles.append(Patch(facecolor=OBSTACLE, edgecolor=OBSTACLE_EDGE, label="obstacle (name, height)"))
     return handles
 

@@ -25,7 +25,7 @@ from cellstress.searchers.common import (
     check_common,
 )
 from cellstress.searchers.distinct import DistinctRecorder, DistinctReward, distinct_problem, hazard_class_record
-from cellstress.searchers.multistart import ArrivalProblem
+from cellstress.searchers.multistart import ArrivalProblem, PhaseProblem
 from cellstress.searchers.result import (
     FORMAT,
     CellRef,
@@ -129,13 +129,12 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
     names = None
     searched_phase = c.spec.human.arrival != "fixed"
     if c.spec.human.starts or searched_phase:
-        problem = ArrivalProblem(sim)
+        problem = ArrivalProblem(sim) if c.spec.human.starts else PhaseProblem(sim)
         names = problem.names
-    if searched_phase and (type(s).needs or (distinct and type(s).whole_episodes)):
-        raise SearchError(f"searcher {s.name!r}" + (" with --distinct" if not type(s).needs else "")
-                          + " does not choose the arrival phase yet; this cell searches it (human.arrival: "
-                          f"{_arrival_text(c.spec.human.arrival)}): use random, mcts, mcts-commit or evolve, or set "
-                          "human.arrival: fixed")
+    if searched_phase and c.spec.human.starts and distinct and type(s).whole_episodes:
+        raise SearchError(f"searcher {s.name!r} with --distinct does not yet choose the arrival phase on a cell with "
+                          f"several start points (human.arrival: {_arrival_text(c.spec.human.arrival)}): use it "
+                          "without --distinct, or random, mcts or mcts-commit, or set human.arrival: fixed")
     rec = None
     missing = [p.__name__ for p in getattr(type(s), "needs", ()) if not isinstance(problem, p)]
     if missing and not (distinct and type(s).whole_episodes):

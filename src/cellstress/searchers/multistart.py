@@ -93,3 +93,30 @@ class ArrivalProblem:
 
 
 MultiStartProblem = ArrivalProblem  # its name before the arrival phase was searched
+
+
+class PhaseProblem(ArrivalProblem):
+    """An ``ArrivalProblem`` with one start point: only the robot's phase is chosen. The worker's own motion does
+    not depend on the robot, so this problem knows it as the simulator does (``core.protocols.WorkerModel``:
+    ``worker_paths`` of the worker's actions, without the first decision)."""
+
+    def __init__(self, sim):
+        super().__init__(sim)
+        if self.m != 1:
+            raise ValueError("a PhaseProblem has one start point")
+        self.steps_per_action = sim.steps_per_action
+        self.params = sim.params
+        self.dt = sim.dt
+
+    def initial_metrics(self):
+        return self.sim.initial_metrics()
+
+    def worker_paths(self, actions):
+        return self.sim.worker_paths(actions)
+
+    def worker_distances(self, poses, points):
+        return self.sim.worker_distances(poses, points)
+
+    def phase_step(self, choice: int) -> int:
+        """The robot's phase of a first decision, in time steps."""
+        return int(round(self.arrival(choice)[1] / self.dt))

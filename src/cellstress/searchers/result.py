@@ -57,6 +57,9 @@ class HazardClass(Record):
     robot_link: Name
     body_region: Name
     approach_cell: tuple[float, float, float, float]
+    # a cell whose arrival phase is searched (absent otherwise): the move of the robot's program at the contact,
+    # 1-based (move i runs from waypoint i to the next, its dwell at waypoint i included)
+    robot_move: Annotated[int, Field(ge=1, le=100_000)] | None = None
 
 
 class EpisodeRef(Record):
@@ -150,6 +153,9 @@ class SearchResult(Record):
         for key in ("distinct", "distinct_sequences"):
             if doc[key] is None:
                 del doc[key]
+        for d in doc.get("distinct") or ():
+            if d["class"]["robot_move"] is None:
+                del d["class"]["robot_move"]
         if doc["cell"]["criterion"] is None:
             del doc["cell"]["criterion"]
         return json_ready(doc)
