@@ -10,7 +10,6 @@ import yaml
 
 from cellstress.cell.load import parse_cell
 from cellstress.searchers import search
-from cellstress.searchers.common import SearchError
 from cellstress.sim.simulator import Simulator
 from cellstress.sim.starts import PHASE_PREFIX, START_PREFIX, parse_phase
 
@@ -74,5 +73,12 @@ def test_several_starts_with_a_searched_phase(tmp_path):
     res = search(sim, "mcts", budget=60, seed=0, until="budget")
     first = res.top[0].actions
     assert first[0].startswith(START_PREFIX) and first[1].startswith(PHASE_PREFIX)
-    with pytest.raises(SearchError, match="arrival phase"):
-        search(sim, "evolve", budget=60, seed=0, until="budget", distinct=True)
+    # the slices (evolve, plan --distinct): each start point's searches choose its phase
+    for name in ("evolve", "plan"):
+        res = search(sim, name, budget=400, seed=0, until="budget", distinct=True)
+        heads = {t.actions[0].split(":")[1] for t in res.top}
+        assert heads and heads <= {s.name for s in sim.cell.spec.human.starts}
+        assert all(t.actions[1].startswith(PHASE_PREFIX) for t in res.top)
+        for d in res.distinct or ():
+            trace = sim.run(list(d.actions))
+            assert trace.unsafe and trace.unsafe_row == d.step

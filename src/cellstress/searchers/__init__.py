@@ -131,10 +131,6 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
     if c.spec.human.starts or searched_phase:
         problem = ArrivalProblem(sim) if c.spec.human.starts else PhaseProblem(sim)
         names = problem.names
-    if searched_phase and c.spec.human.starts and distinct and type(s).whole_episodes:
-        raise SearchError(f"searcher {s.name!r} with --distinct does not yet choose the arrival phase on a cell with "
-                          f"several start points (human.arrival: {_arrival_text(c.spec.human.arrival)}): use it "
-                          "without --distinct, or random, mcts or mcts-commit, or set human.arrival: fixed")
     rec = None
     missing = [p.__name__ for p in getattr(type(s), "needs", ()) if not isinstance(problem, p)]
     if missing and not (distinct and type(s).whole_episodes):
@@ -184,10 +180,6 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
             distinct_record(sim, hazard_class_record(key), episode, names(actions))
             for key, (episode, actions) in rec.classes.items()),
     )
-
-
-def _arrival_text(arrival) -> str:
-    return arrival if isinstance(arrival, str) else f"{{start: {arrival.start:g}, end: {arrival.end:g}}}"
 
 
 def _unsafe_row(sim: Simulator, actions: list[str]):

@@ -19,9 +19,13 @@ from cellstress.sim.starts import START_PREFIX, arrival_phases, phase_token, sta
 
 
 class ArrivalProblem:
-    def __init__(self, sim):
+    """The first decision picks a start point and a phase (module docstring); ``only`` = i keeps the start point
+    ``human.starts[i]`` alone (the phase is then the only choice: ``search.slices`` searches each start so)."""
+
+    def __init__(self, sim, only: int | None = None):
         self.sim = sim
-        self.starts = sim.cell.spec.human.starts
+        starts = sim.cell.spec.human.starts
+        self.starts = starts if only is None else (starts[only],)
         self.searched_phase = sim.cell.spec.human.arrival != "fixed"
         # per start point (or the one start pose): its phases; all starts have as many (1 when fixed)
         points = self.starts or (None,)
@@ -100,8 +104,8 @@ class PhaseProblem(ArrivalProblem):
     not depend on the robot, so this problem knows it as the simulator does (``core.protocols.WorkerModel``:
     ``worker_paths`` of the worker's actions, without the first decision)."""
 
-    def __init__(self, sim):
-        super().__init__(sim)
+    def __init__(self, sim, only: int | None = None):
+        super().__init__(sim, only)
         if self.m != 1:
             raise ValueError("a PhaseProblem has one start point")
         self.steps_per_action = sim.steps_per_action
