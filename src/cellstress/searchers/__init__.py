@@ -36,6 +36,7 @@ from cellstress.searchers.result import (
     TopEpisode,
 )
 from cellstress.searchers.slices import ClassRecorder, cell_starts, run_slices
+from cellstress.searchers.why import explain
 from cellstress.sim.simulator import Simulator
 
 DEFAULT_BUDGET = 200
@@ -198,7 +199,8 @@ def hazard_record(sim: Simulator, episode: int, actions: list[str]) -> Hazard:
     return Hazard.model_construct(
         episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.t, robot_link=hit.robot_link,
         body_part=hit.body_part, point=hit.robot_point, human_point=hit.human_point, v_R=hit.v_R, d_HR=hit.d_HR,
-        trace=records, **({} if verdict is None else {sim.criterion.type: verdict.as_dict()}))
+        trace=records, why=explain(trace.layout, records, trace.unsafe_row),
+        **({} if verdict is None else {sim.criterion.type: verdict.as_dict()}))
 
 
 def distinct_record(sim: Simulator, klass, episode: int, actions: list[str]) -> DistinctHazard:
@@ -207,4 +209,5 @@ def distinct_record(sim: Simulator, klass, episode: int, actions: list[str]) -> 
     hit = records[trace.unsafe_row]
     return DistinctHazard.model_construct(
         klass=klass, episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.t,
-        robot_link=hit.robot_link, body_part=hit.body_part, v_R=hit.v_R, trace=records)
+        robot_link=hit.robot_link, body_part=hit.body_part, v_R=hit.v_R, trace=records,
+        why=explain(trace.layout, records, trace.unsafe_row))

@@ -75,6 +75,35 @@ class TopEpisode(Record):
     unsafe: bool
 
 
+class DeviceTiming(Record):
+    """One safety device in a hazardous episode: when it first saw the worker, and when its stop took effect."""
+
+    device: Name
+    saw_at_s: float | None
+    """First time the device saw the worker [s]; None: never, up to the contact."""
+    stop_at_s: float | None
+    """When the stop it asked for took effect (saw_at_s plus its response time) [s]."""
+
+
+class Why(Record):
+    """Why a hazardous episode was not prevented, from its timeline (``searchers.why``)."""
+
+    detected: bool
+    """Did any device see the worker before the contact?"""
+    devices: Annotated[tuple[DeviceTiming, ...], Field(max_length=1000)]
+    """Every device of the cell, in the cell's order."""
+    stopped_by: Name | None
+    """The device whose stop took effect first; None: undetected."""
+    braking_from_s: float | None
+    """When the robot began to brake [s]."""
+    standstill_at_s: float | None
+    """When the robot stood (or would have stood) still [s]."""
+    contact_at_s: float
+    """The unsafe contact [s]."""
+    late_by_s: float | None
+    """How much earlier the robot needed to stand still: standstill_at_s - contact_at_s [s]."""
+
+
 class Hazard(Record):
     """The first hazardous episode: its actions, the unsafe step and its trace. A criterion that judges contacts
     adds its verdict under the criterion's name (e.g. ``iso15066``): the one field not declared here."""
@@ -92,6 +121,7 @@ class Hazard(Record):
     v_R: float | None
     d_HR: float | None
     trace: Trace
+    why: Why | None = None  # absent from files written before it was recorded
 
     @model_validator(mode="after")
     def _one_verdict(self) -> Hazard:
@@ -123,6 +153,7 @@ class DistinctHazard(Record):
     body_part: Name | None
     v_R: float | None
     trace: Trace
+    why: Why | None = None  # absent from files written before it was recorded
 
 
 class SearchResult(Record):
@@ -156,6 +187,9 @@ class SearchResult(Record):
         for d in doc.get("distinct") or ():
             if d["class"]["robot_move"] is None:
                 del d["class"]["robot_move"]
+        for h in (doc["hazard"], *(doc.get("distinct") or ())):
+            if h is not None and h.get("why", 0) is None:
+                del h["why"]
         if doc["cell"]["criterion"] is None:
             del doc["cell"]["criterion"]
         return json_ready(doc)
