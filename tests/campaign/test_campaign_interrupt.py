@@ -30,7 +30,13 @@ def _start(out: Path, workers: int) -> subprocess.Popen:
     # a session of its own: the test's signals reach only the processes it started
     return subprocess.Popen([sys.executable, "-m", "cellstress", "campaign", *ARGS, "--workers", str(workers),
                              "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env=env, start_new_session=True)
+                            env=env, start_new_session=True, preexec_fn=_default_sigint)
+
+
+def _default_sigint() -> None:
+    # an ignored SIGINT is inherited across exec: a library an earlier test ran in this process (Ray's start-up)
+    # may have left it ignored, and the campaign would then never see the test's SIGINT
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def _lines(out: Path) -> int:
