@@ -20,9 +20,9 @@ def check(
 
     from cellstress.analysis.iso13855 import check_cell
     from cellstress.cell.load import BUILTIN_CELLS, builtin_file, load_cell
+    from cellstress.cell.program import robot_program
     from cellstress.robot.capsules import declared_capsule, fitted_capsules
     from cellstress.robot.model import load_robot, resolve_urdf
-    from cellstress.robot.trajectory import build_trajectory
 
     with spinner_while_compiling(), user_errors():
         c = load_cell(cell)
@@ -40,7 +40,7 @@ def check(
         for i, k in enumerate(spec.robot.extra_capsules):
             caps.append(declared_capsule(robot, f"{k.link}#extra{i}", k.link, k.p0, k.p1, k.radius))
         task = spec.robot.task
-        traj = build_trajectory(task.waypoints_deg, task.dwell, task.speed_scale, robot.velocity_limits)
+        traj = robot_program(c.source, robot, spec.robot, c.directory)
         static = check_cell(c)
 
     out = say
@@ -57,8 +57,16 @@ def check(
     for k in caps:
         length = float(np.linalg.norm(np.subtract(k.p1, k.p0)))
         out(f"            {k.name:<18} on joint {k.joint:>2}  radius {k.radius:.3f} m  length {length:.3f} m")
-    out(f"task        {len(task.waypoints_deg)} waypoints, dwell {num(task.dwell)} s, speed scale "
-        f"{num(task.speed_scale)}, phase {num(task.phase)} s, cycle time {traj.cycle:.2f} s")
+    if task.trajectory_csv:
+        out(f"task        trajectory file {task.trajectory_csv}, {traj.n_segments + 1} rows, linear moves, "
+            f"phase {num(task.phase)} s, cycle time {traj.cycle:.2f} s")
+    else:
+        what = f"{len(task.poses)} tool poses of {task.tool_frame}" if task.poses else \
+            f"{len(task.waypoints_deg)} waypoints"
+        dwell = "per waypoint" if task.dwells else f"{num(task.dwell)} s"
+        scale = "per move" if task.speed_scales else num(task.speed_scale)
+        out(f"task        {what}, dwell {dwell}, speed scale {scale}, phase {num(task.phase)} s, "
+            f"cycle time {traj.cycle:.2f} s")
     out(f"table       {len(spec.table.polygons)} polygon(s), height {num(spec.table.height)} m")
     panels = sum(len(f.points) - 1 for f in spec.fences)
     out(f"fences      {len(spec.fences)} ({panels} straight segments)")
