@@ -143,3 +143,12 @@ def test_panda_cell_runs_episodes(panda_sim):
     r = panda_sim.run_batch(acts)
     assert np.isfinite(r.min_d).all() and (r.min_d > 0.0).any()
     assert panda_sim.params.pre_v.max() > 0.3  # m/s: the arm does move
+
+
+def test_search_runs_on_the_panda_cell(tmp_path, capsys):
+    from cellstress.cli import main
+
+    code = main(["search", str(CELL), "--searcher", "mcts", "--budget", "64", "--seed", "0", "--no-report",
+                 "--out", str(tmp_path)])
+    assert code in (0, 1), capsys.readouterr().err  # 1: a hazard found; either way the search ran
+    assert (tmp_path / "result.json").is_file()

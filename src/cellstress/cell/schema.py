@@ -164,7 +164,7 @@ class TaskSpec(Record):
             if given[0] == "trajectory_csv":
                 raise ValueError(f"{name} is for waypoint programs; a trajectory file has its own timing")
             if len(values) != count:
-                raise ValueError(f"{name} has {len(values)} values; give one per waypoint ({count})")
+                raise ValueError(f"{name} has {len(values)} value(s); give one per waypoint ({count})")
         return self
 
 
