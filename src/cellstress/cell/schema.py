@@ -157,6 +157,9 @@ class TaskSpec(Record):
             raise ValueError(f"{given[0]} needs at least 2 waypoints, got {count}")
         if self.poses and self.tool_frame is None:
             raise ValueError("poses need tool_frame: the URDF link they place (e.g. tool0)")
+        for name, needs in (("tool_frame", "poses"), ("ik_seed_deg", "poses"), ("csv_degrees", "trajectory_csv")):
+            if getattr(self, name) not in (None, False) and not getattr(self, needs):
+                raise ValueError(f"{name} is for a program of {needs}; this one has none")
         for name in ("speed_scales", "dwells"):
             values = getattr(self, name)
             if values is None:
