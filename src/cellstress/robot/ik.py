@@ -23,6 +23,7 @@ RESTARTS = 12
 ITERATIONS = 300
 DAMPING = 1e-6
 MAX_STEP = 0.5  # rad (or m) per iteration
+NULL_GAIN = 0.5
 
 
 class Unreachable(CellstressError):
@@ -60,7 +61,10 @@ def _solve(pin, model, data, frame_id, e, jmap, target, seed, lo, hi):
             break
         jac = pin.computeFrameJacobian(model, data, q, frame_id, pin.ReferenceFrame.LOCAL) @ e
         a = -pin.Jlog6(current.actInv(target).inverse()) @ jac  # d err / d x
-        step = -a.T @ np.linalg.solve(a @ a.T + DAMPING * np.eye(6), err)
+        pinv = a.T @ np.linalg.inv(a @ a.T + DAMPING * np.eye(6))
+        # the pose error's step, plus (in the null space of the pose: a redundant arm's free motion) a pull
+        # back towards the start, so the solution is the one nearest the previous waypoint, not any one
+        step = -pinv @ err + NULL_GAIN * (seed - x - pinv @ (a @ (seed - x)))
         norm = float(np.linalg.norm(step))
         if norm > MAX_STEP:  # far from the target the linearisation overshoots
             step *= MAX_STEP / norm
