@@ -50,7 +50,10 @@ def check(
         out(f"            {first_sentence(spec.description)}")
     base = spec.robot.base
     out(f"robot       {spec.robot.urdf} -> {urdf}")
-    out(f"            {robot.n_joints} joints, base at ({', '.join(num(v) for v in base.xyz)}) "
+    n_mimic = int((robot.mimic_master >= 0).sum())
+    follow = [f"{n} {what}" for n, what in ((len(spec.robot.hold), "held"), (n_mimic, "mimic")) if n]
+    joints = f"{robot.n_joints} joints" + (f" ({', '.join(follow)})" if follow else "")
+    out(f"            {joints}, base at ({', '.join(num(v) for v in base.xyz)}) "
         f"yaw {num(base.yaw_deg)} deg, stopping time {num(spec.robot.stopping_time)} s")
     extra = f" + {len(caps) - n_own} extra" if len(caps) > n_own else ""
     out(f"capsules    {len(caps)} ({n_own} {cap_kind}{extra})")
