@@ -152,3 +152,35 @@ def test_search_runs_on_the_panda_cell(tmp_path, capsys):
                  "--out", str(tmp_path)])
     assert code in (0, 1), capsys.readouterr().err  # 1: a hazard found; either way the search ran
     assert (tmp_path / "result.json").is_file()
+
+
+def test_reflected_mass_locks_the_held_fingers(panda_sim):
+    """The ISO/TS 15066 reflected mass at a contact on the Panda is that of its 7 driven joints, the held finger
+    (and its mimic) locked: the same as pinocchio's own reduced model with the finger joints locked."""
+    from cellstress.robot.dynamics import point_dynamics, reflected_mass
+    from cellstress.sim import scene
+    from cellstress.sim.contacts import ContactModel
+
+    layout = panda_sim.layout
+    cm = ContactModel(layout)
+    assert cm.reduce.shape == (9, 7)
+    rng = np.random.default_rng(4)
+    rows = panda_sim.run(rng.integers(0, 30, panda_sim.actions_per_episode)).rows
+    full = pin.buildModelFromUrdf(str(layout.robot.urdf))
+    checked = 0
+    for row in rows[1:]:
+        link = int(row[L.M_LINK])
+        j = int(panda_sim.params.cap_joint[link])
+        if j < 0:
+            continue
+        contact = cm.contact(row)
+        q, _ = scene.joint_state(layout, row)
+        reduced = pin.buildReducedModel(full, [8, 9], q)  # pinocchio's finger joints (1-based) locked at q
+        data = reduced.createData()
+        base = panda_sim.params.base
+        pb = base[:3, :3].T @ (np.asarray(contact.robot_point) - base[:3, 3])
+        jac, mass = point_dynamics(reduced, data, q[:7], j + 1, pb)
+        want = reflected_mass(jac, mass, base[:3, :3].T @ np.asarray(contact.normal))
+        assert contact.reflected_mass == pytest.approx(want, rel=1e-9)
+        checked += 1
+    assert checked > 5

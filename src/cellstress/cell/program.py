@@ -70,7 +70,7 @@ def _per_move(task, name: str, default: float, n: int) -> np.ndarray:
     return np.full(n, default) if values is None else np.asarray(values, dtype=float)
 
 
-def waypoint_program(src: str, jmap: JointMap, spec: RobotSpec, directory) -> Trajectory:
+def waypoint_program(src: str, jmap: JointMap, spec: RobotSpec, directory: Path | None) -> Trajectory:
     """Minimum-jerk moves through ``waypoints_deg`` or through the joint solutions of ``poses``."""
     task, robot = spec.task, jmap.robot
     nd = len(jmap.driven)
@@ -127,7 +127,7 @@ def _pose_matrix(xyz, rpy_deg) -> np.ndarray:
     return m
 
 
-def file_program(src: str, jmap: JointMap, spec: RobotSpec, directory) -> Trajectory:
+def file_program(src: str, jmap: JointMap, spec: RobotSpec, directory: Path | None) -> Trajectory:
     """Linear moves through the rows of ``trajectory_csv``, each row within the position limits and each move
     within the velocity limits."""
     task, robot = spec.task, jmap.robot
@@ -169,7 +169,7 @@ def _relative(ref: str, directory: Path | None) -> Path:
     return directory / path if not path.is_absolute() and directory is not None else path
 
 
-def robot_program(src: str, robot: RobotModel, spec: RobotSpec, directory) -> Trajectory:
+def robot_program(src: str, robot: RobotModel, spec: RobotSpec, directory: Path | None) -> Trajectory:
     """The robot's cyclic program as a Trajectory, every joint limit checked; CellError otherwise."""
     jmap = held_joints(src, robot, spec)
     if not jmap.driven:

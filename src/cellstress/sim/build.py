@@ -8,12 +8,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from cellstress.cell.load import Cell
-from cellstress.cell.program import robot_program
+from cellstress.cell.program import held_joints, robot_program
 from cellstress.core.records import ScanPlane, VerticalField
 from cellstress.human.actions import action_table
 from cellstress.human.body import BodyDimensions
 from cellstress.human.reach import ReachField, reach_field
 from cellstress.robot.capsules import Capsule, declared_capsule, fitted_capsules
+from cellstress.robot.joints import JointMap
 from cellstress.robot.model import PRISMATIC, RobotModel, base_matrix, load_robot, resolve_urdf
 from cellstress.robot.trajectory import Trajectory
 from cellstress.sim import kernels as K
@@ -78,6 +79,7 @@ class Layout:
     reach: ReachField
     device_names: tuple[str, ...]
     params: K.SimParams
+    joints: JointMap  # the joints the program drives; the others are held or mimic ones
 
 
 def build_layout(cell: Cell) -> Layout:
@@ -158,7 +160,8 @@ def build_layout(cell: Cell) -> Layout:
         pre_tau=np.zeros(0),
     )
     params = _with_robot_table(params, spec)
-    return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params)
+    joints = held_joints(cell.source, robot, spec.robot)
+    return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params, joints)
 
 
 def _with_robot_table(params: K.SimParams, spec) -> K.SimParams:
