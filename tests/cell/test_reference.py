@@ -77,7 +77,7 @@ def test_cells_and_check_say_where_the_files_are(capsys) -> None:
     assert f"(built-in: {builtin_file('baseline')}, sha256" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("robot", ["panda", "ur5", "z1"])
+@pytest.mark.parametrize("robot", ["panda", "ur5", "z1", "kinova"])
 def test_new_with_a_robot_writes_a_starter_that_passes_check(robot, tmp_path, capsys, monkeypatch) -> None:
     monkeypatch.chdir(tmp_path)
     assert main(["new", "cell", "--robot", robot]) == 0
@@ -91,6 +91,6 @@ def test_new_with_a_robot_writes_a_starter_that_passes_check(robot, tmp_path, ca
 
 def test_new_refuses_an_unknown_robot(tmp_path, capsys, monkeypatch) -> None:
     monkeypatch.chdir(tmp_path)
-    assert main(["new", "cell", "--robot", "kinova"]) == 2
+    assert main(["new", "cell", "--robot", "kuka"]) == 2
     assert "not a built-in robot (ur3, ur5, ur10" in capsys.readouterr().err
     assert not (tmp_path / "cell.yaml").exists()

@@ -56,3 +56,21 @@ def test_an_unreachable_pose_reports_how_far(panda):
         solve_poses(jmap, "panda_hand", [hand_pose(jmap, model, data, np.zeros(7)), far], np.zeros(7))
     assert err.value.index == 1
     assert err.value.residual[0] > 0.9  # m: the Panda reaches about 0.86 m
+
+
+def test_poses_of_an_arm_with_continuous_joints():
+    """IK through pinocchio's (cos, sin) joints of the Kinova: the poses of known joint values are reached."""
+    robot = load_robot(resolve_urdf("kinova", None))
+    jmap = joint_map(robot, {})
+    model = pin.buildModelFromUrdf(str(robot.urdf))
+    data = model.createData()
+    fid = model.getFrameId("j2s6s200_end_effector")
+    path = [np.array([0.3, 2.5, 3.0, 0.2, 2.0, 0.1]), np.array([1.0, 2.8, 2.6, -0.3, 2.4, 0.8])]
+    poses = []
+    for x in path:
+        pin.framesForwardKinematics(model, data, robot.pinocchio_q(x))
+        poses.append(data.oMf[fid].homogeneous.copy())
+    sol = solve_poses(jmap, "j2s6s200_end_effector", poses, np.array([0.0, 2.6, 2.8, 0.0, 2.2, 0.0]))
+    for x, pose in zip(sol, poses, strict=True):
+        pin.framesForwardKinematics(model, data, robot.pinocchio_q(x))
+        assert np.linalg.norm(data.oMf[fid].translation - pose[:3, 3]) < 1e-4  # (the tolerance is 1 mm)

@@ -14,7 +14,6 @@ from cellstress.robot.joints import joint_map
 from cellstress.robot.model import (
     BUILTIN_ROBOTS,
     PRISMATIC,
-    example_robot_data_share,
     load_robot,
     resolve_urdf,
     unknown_urdf_message,
@@ -55,10 +54,31 @@ def test_unknown_short_name_message():
     assert "URDF file not found: /cells/arm.urdf" in unknown_urdf_message("arm.urdf", Path("/cells/arm.urdf"))
 
 
-def test_continuous_joints_are_refused_clearly():
-    kinova = example_robot_data_share() / "robots/kinova_description/robots/kinova.urdf"
-    with pytest.raises(CellstressError, match="is continuous .unbounded.*<limit lower"):
-        load_robot(kinova)
+def test_continuous_joints_are_unbounded_revolute_joints():
+    """The Kinova's continuous joints (pinocchio's nq = 2: cos, sin) are revolute joints without angle limits;
+    the kernel's FK at any angles, even past a turn, is pinocchio's at pinocchio_q of them."""
+    robot = load_robot(resolve_urdf("kinova", None))
+    np.testing.assert_array_equal(robot.continuous, [True, False, False, True, False, True])
+    assert np.isinf(robot.lower[robot.continuous]).all() and np.isinf(robot.upper[robot.continuous]).all()
+    assert np.isfinite(robot.lower[~robot.continuous]).all()
+    model = pin.buildModelFromUrdf(str(robot.urdf))
+    data = model.createData()
+    jtype = np.full(6, L.JOINT_REVOLUTE)
+    rng = np.random.default_rng(2)
+    lo, hi = robot.sampling_range()
+    rot, pos = np.zeros((6, 3, 3)), np.zeros((6, 3))
+    for q in rng.uniform(lo, hi, (200, 6)) + np.where(robot.continuous, rng.integers(-3, 4, 6) * 2 * np.pi, 0.0):
+        _forward_kinematics(robot.parents, robot.placements, np.eye(4), robot.axes, jtype, q, rot, pos)
+        pin.forwardKinematics(model, data, robot.pinocchio_q(q))
+        for j in range(6):
+            np.testing.assert_allclose(pos[j], data.oMi[j + 1].translation, atol=1e-12)
+            np.testing.assert_allclose(rot[j], data.oMi[j + 1].rotation, atol=1e-12)
+
+
+def test_pinocchio_q_is_q_without_continuous_joints():
+    robot = load_robot(resolve_urdf("ur10", None))
+    q = np.arange(6.0)
+    assert robot.pinocchio_q(q) is q
 
 
 def test_mimic_with_multiplier_and_offset(tmp_path):

@@ -43,7 +43,8 @@ def held_joints(src: str, robot: RobotModel, spec: RobotSpec) -> JointMap:
 
 def _at(robot: RobotModel, j: int, value: float) -> np.ndarray:
     """A joint vector inside every limit but joint j's, which is ``value``."""
-    q = 0.5 * (robot.lower + robot.upper)
+    lo, hi = robot.sampling_range()
+    q = 0.5 * (lo + hi)
     q[j] = value
     return q
 
@@ -101,7 +102,8 @@ def _solve_poses(src: str, jmap: JointMap, spec: RobotSpec) -> np.ndarray:
                                                            f"drives {len(driven)} joints: {driven_list(jmap)}")
         seed = jmap.from_user(np.asarray(task.ik_seed_deg, dtype=float))
     else:
-        seed = 0.5 * (robot.lower[driven] + robot.upper[driven])
+        lo, hi = robot.sampling_range()
+        seed = 0.5 * (lo[driven] + hi[driven])
     to_base = np.linalg.inv(base_matrix(spec.base.xyz, spec.base.yaw_deg))
     targets = [to_base @ _pose_matrix(p.xyz, p.rpy_deg) for p in task.poses]
     try:

@@ -33,12 +33,12 @@ those installed (plug-ins add theirs: docs/extending.md).
 
 ## Robots and their programs
 
-`robot.urdf` is a short name of example-robot-data (`cellstress cells` lists them: ur3, ur5, ur10, panda, xarm7,
-...) or a URDF file: any serial chain of revolute and prismatic joints, fixed joints and `<mimic>` joints
-included (continuous joints are refused: give them limits). Joint values are degrees, or metres for a prismatic
-joint. A program gives one value per *driven* joint: every joint but the `<mimic>` ones (they follow their
-master) and those in `robot.hold`. Every value is checked against the URDF's position limits, and a
-trajectory file also against its velocity limits. `cellstress new NAME --robot panda` writes a starter cell.
+`robot.urdf` is a short name of example-robot-data (`cellstress cells` lists them: ur3, ur5, ur10, panda, kinova,
+xarm7, ...) or a URDF file: any serial chain of revolute, continuous and prismatic joints, fixed joints and
+`<mimic>` joints included. Joint values are degrees, or metres for a prismatic joint. A program gives one value
+per *driven* joint: every joint but the `<mimic>` ones (they follow their master) and those in `robot.hold`.
+Every value is checked against the URDF's position limits, and a trajectory file also against its velocity
+limits. `cellstress new NAME --robot panda` writes a starter cell.
 The program takes one of three forms:
 
 ```yaml

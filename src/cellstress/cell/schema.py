@@ -188,8 +188,8 @@ class RobotSpec(Record):
 
     urdf: Annotated[str, Field(min_length=1, max_length=1000, pattern=r"^[^\x00]+$")] = "ur10"
     """A robot of example-robot-data by its short name (ur3, ur5, ur10, ur3-gripper, ur5-gripper, panda,
-    xarm7, z1, so100, so101) or the path of a URDF file, relative to the cell file: a serial chain of revolute
-    and prismatic joints (fixed and ``<mimic>`` joints too), with position and velocity limits."""
+    kinova, xarm7, z1, so100, so101) or the path of a URDF file, relative to the cell file: a serial chain of
+    revolute, continuous and prismatic joints (fixed and ``<mimic>`` joints too), with velocity limits."""
     base: Pose = Pose()
     """The base frame in the cell."""
     capsules: CapsulesField = "auto"

@@ -30,10 +30,11 @@ def robot_block(short_name: str) -> str:
 
     robot = load_robot(resolve_urdf(short_name, None))
     jmap = joint_map(robot, {})
-    mid = 0.5 * (robot.lower + robot.upper)
+    lo, hi = robot.sampling_range()
+    mid = 0.5 * (lo + hi)
     turned = mid.copy()
     j0 = jmap.driven[0]
-    turned[j0] += min(0.25 * (robot.upper[j0] - robot.lower[j0]), float(np.deg2rad(90.0)))
+    turned[j0] += min(0.25 * (hi[j0] - lo[j0]), float(np.deg2rad(90.0)))
 
     def row(q) -> str:
         # rounded to 0.1 deg / 0.1 mm: the middle of a range and a quarter of it stay well within the limits

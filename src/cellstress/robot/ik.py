@@ -54,7 +54,7 @@ def _solve(pin, model, data, frame_id, e, jmap, target, seed, lo, hi):
     x = seed.copy()
     best = (np.inf, np.inf)
     for _ in range(ITERATIONS):
-        q = jmap.expand(x)
+        q = jmap.robot.pinocchio_q(jmap.expand(x))
         err, current = _pose_error(pin, model, data, frame_id, q, target)
         best = (float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:])))
         if best[0] < 1e-7 and best[1] < 1e-7:  # well inside the tolerance, so the check below is not marginal
@@ -70,7 +70,7 @@ def _solve(pin, model, data, frame_id, e, jmap, target, seed, lo, hi):
             step *= MAX_STEP / norm
         x = np.clip(x + step, lo, hi)
     # the residual of the final x, measured in the target's frame as position and angle
-    q = jmap.expand(x)
+    q = jmap.robot.pinocchio_q(jmap.expand(x))
     pin.framesForwardKinematics(model, data, q)
     rel = data.oMf[frame_id].actInv(target)
     residual = (float(np.linalg.norm(rel.translation)), float(np.linalg.norm(pin.log3(rel.rotation))))
@@ -92,7 +92,7 @@ def solve_poses(jmap: JointMap, frame: str, targets: list[np.ndarray], seed: np.
     driven = list(jmap.driven)
     lo, hi = robot.lower[driven], robot.upper[driven]
     rng = np.random.default_rng(0)  # restarts are deterministic: same cell, same waypoints
-    restarts = rng.uniform(lo, hi, (RESTARTS, len(driven)))
+    restarts = rng.uniform(*(r[driven] for r in robot.sampling_range()), (RESTARTS, len(driven)))
     out = []
     previous = np.clip(seed, lo, hi)
     for i, target in enumerate(targets):

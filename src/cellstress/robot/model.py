@@ -18,7 +18,7 @@ import numpy as np
 from cellstress.core.errors import CellstressError
 
 # Short names for the fixed-base serial arms shipped by example-robot-data, resolved to files inside that
-# package. (Its kinova arm is left out: its joints are continuous, which cellstress does not model.)
+# package.
 BUILTIN_URDFS = {
     "ur3": "robots/ur_description/urdf/ur3_robot.urdf",
     "ur5": "robots/ur_description/urdf/ur5_robot.urdf",
@@ -26,6 +26,7 @@ BUILTIN_URDFS = {
     "ur3-gripper": "robots/ur_description/urdf/ur3_gripper.urdf",
     "ur5-gripper": "robots/ur_description/urdf/ur5_gripper.urdf",
     "panda": "robots/panda_description/urdf/panda.urdf",
+    "kinova": "robots/kinova_description/robots/kinova.urdf",
     "xarm7": "robots/xarm_description/urdf/xarm7.urdf",
     "z1": "robots/z1_description/urdf/z1.urdf",
     "so100": "robots/so_arm_description/urdf/so100.urdf",
@@ -88,6 +89,8 @@ class RobotModel:
     (revolute) or sliding (prismatic) axis in its own frame, ``parents[j]`` the parent joint index (-1 for the
     base), ``kinds[j]`` REVOLUTE or PRISMATIC. Joint values are radians or metres. A URDF ``<mimic>`` joint m
     follows its master: q[m] = mimic_multiplier[m] * q[mimic_master[m]] + mimic_offset[m] (master -1: none).
+    A continuous joint is a revolute one without limits (``lower`` -inf, ``upper`` inf); pinocchio keeps its
+    angle as (cos, sin), so pinocchio takes ``pinocchio_q(q)``.
     """
 
     urdf: Path
@@ -102,6 +105,7 @@ class RobotModel:
     mimic_master: np.ndarray
     mimic_multiplier: np.ndarray
     mimic_offset: np.ndarray
+    continuous: np.ndarray  # (nj,) bool
     link_joint: dict[str, int]
     link_in_joint: dict[str, np.ndarray]
 
@@ -112,6 +116,18 @@ class RobotModel:
     def link_frame(self, link: str) -> tuple[int, np.ndarray]:
         """(joint index the link is fixed to, 4x4 placement of the link frame in that joint's frame)."""
         return self.link_joint[link], self.link_in_joint[link]
+
+    def pinocchio_q(self, q: np.ndarray) -> np.ndarray:
+        """Pinocchio's configuration vector for joint values q: (cos, sin) for a continuous joint."""
+        if not self.continuous.any():
+            return q
+        parts = [np.array([np.cos(x), np.sin(x)]) if c else np.array([x]) for x, c in zip(q, self.continuous,
+                                                                                          strict=True)]
+        return np.concatenate(parts)
+
+    def sampling_range(self) -> tuple[np.ndarray, np.ndarray]:
+        """Finite joint ranges to choose values from: the limits, and one turn for a continuous joint."""
+        return np.where(self.continuous, -np.pi, self.lower), np.where(self.continuous, np.pi, self.upper)
 
     def unit(self, j: int) -> str:
         """The unit a cell file gives joint j's values in."""
@@ -175,15 +191,11 @@ def urdf_mimics(urdf: Path) -> dict[str, tuple[str, float, float]]:
 
 def _joint_kind_axis(urdf: Path, name: str, joint) -> tuple[str, tuple[float, float, float]]:
     short = joint.shortname().replace("JointModel", "")
-    if short in ("RX", "RY", "RZ", "PX", "PY", "PZ"):
-        return (REVOLUTE if short[0] == "R" else PRISMATIC), _AXES[short[1]]
-    if short in ("RevoluteUnaligned", "PrismaticUnaligned"):
+    if short in ("RX", "RY", "RZ", "PX", "PY", "PZ", "RUBX", "RUBY", "RUBZ"):
+        return (REVOLUTE if short[0] == "R" else PRISMATIC), _AXES[short[-1]]
+    if short in ("RevoluteUnaligned", "PrismaticUnaligned", "RevoluteUnboundedUnaligned"):
         kind = REVOLUTE if short.startswith("R") else PRISMATIC
         return kind, tuple(float(x) for x in np.asarray(joint.extract().axis, dtype=float))
-    if short.startswith("RUB") or short == "RevoluteUnboundedUnaligned":
-        raise CellstressError(f"{urdf}: joint {name!r} is continuous (unbounded); cellstress models bounded "
-                              "revolute and prismatic joints: make it a revolute joint with <limit lower=... "
-                              "upper=...> in a copy of the URDF")
     raise CellstressError(f"{urdf}: joint {name!r} is of type {short}; only revolute, prismatic and fixed "
                           "joints (and <mimic> joints of those) are supported")
 
@@ -210,7 +222,7 @@ def load_robot(urdf: Path) -> RobotModel:
     import pinocchio as pin
 
     model = load_pinocchio(urdf)
-    names, kinds, parents, placements, axes, vmax, lower, upper = [], [], [], [], [], [], [], []
+    names, kinds, parents, placements, axes, vmax, lower, upper, continuous = [], [], [], [], [], [], [], [], []
     for j in range(1, model.njoints):
         joint = model.joints[j]
         kind, axis = _joint_kind_axis(urdf, model.names[j], joint)
@@ -220,12 +232,14 @@ def load_robot(urdf: Path) -> RobotModel:
         placements.append(_se3(model.jointPlacements[j]))
         axes.append(axis)
         vmax.append(model.velocityLimit[joint.idx_v])
-        lower.append(model.lowerPositionLimit[joint.idx_q])
-        upper.append(model.upperPositionLimit[joint.idx_q])
-    for name, v, lo, hi in zip(names, vmax, lower, upper, strict=True):
+        # a continuous joint (nq 2: cos, sin) has no angle limits; pinocchio's bounds are those of cos and sin
+        continuous.append(joint.nq == 2)
+        lower.append(-np.inf if joint.nq == 2 else model.lowerPositionLimit[joint.idx_q])
+        upper.append(np.inf if joint.nq == 2 else model.upperPositionLimit[joint.idx_q])
+    for name, v, lo, hi, cont in zip(names, vmax, lower, upper, continuous, strict=True):
         if not (np.isfinite(v) and v > 0.0):
             raise CellstressError(f"{urdf}: joint {name!r} has no velocity limit (<limit velocity=...> > 0)")
-        if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
+        if not cont and not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
             raise CellstressError(f"{urdf}: joint {name!r} has no finite position limits (<limit lower=... "
                                   "upper=...>)")
     master, mult, off = _mimic_arrays(urdf, names)
@@ -248,6 +262,7 @@ def load_robot(urdf: Path) -> RobotModel:
         mimic_master=master,
         mimic_multiplier=mult,
         mimic_offset=off,
+        continuous=np.asarray(continuous, dtype=bool),
         link_joint=link_joint,
         link_in_joint=link_in_joint,
     )

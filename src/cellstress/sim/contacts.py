@@ -55,7 +55,7 @@ class ContactModel:
         else:
             pb = self.R_base.T @ (rp - self.t_base)  # pinocchio works in the robot base frame
             nb = self.R_base.T @ n
-            Jp, M = point_dynamics(self.model, self.data, q, j + 1, pb)
+            Jp, M = point_dynamics(self.model, self.data, lay.robot.pinocchio_q(q), j + 1, pb)
             if self.reduce is None:
                 m_r = reflected_mass(Jp, M, nb)
             else:
