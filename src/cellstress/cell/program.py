@@ -23,6 +23,8 @@ VELOCITY_SLACK = 1e-9  # relative: a trajectory file sampled exactly at a joint'
 
 
 def held_joints(src: str, robot: RobotModel, spec: RobotSpec) -> JointMap:
+    """The joints ``robot.hold`` holds (each a joint of the chain, not a mimic one, within its limits) and so
+    the ones the program drives."""
     index = {n: j for j, n in enumerate(robot.joint_names)}
     held: dict[int, float] = {}
     for i, h in enumerate(spec.hold):
@@ -50,6 +52,7 @@ def _at(robot: RobotModel, j: int, value: float) -> np.ndarray:
 
 
 def driven_list(jmap: JointMap) -> str:
+    """The driven joints with their units, for an error that says what a program must give."""
     return ", ".join(f"{n} [{jmap.robot.unit(j)}]" for j, n in zip(jmap.driven, jmap.driven_names, strict=True))
 
 

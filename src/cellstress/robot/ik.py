@@ -3,13 +3,12 @@ one waypoint to the next.
 
 Damped least squares on the pose error log6(oMf^-1 oMdes) (pinocchio's own formulation), over the driven joints
 only (mimic joints follow through the JointMap), each step clipped to the joint limits. The previous
-waypoint's solution is tried first; a few deterministic restarts cover the case it cannot reach, and among the
-solutions found the closest to the previous waypoint is kept, so the arm does not flip configuration.
+waypoint's solution is tried first, with a pull in the null space of the pose (a redundant arm's free motion)
+back towards it; a few deterministic restarts cover the case it cannot reach, and among the solutions found the
+closest to the previous waypoint is kept, so the arm does not flip configuration.
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -34,12 +33,6 @@ class Unreachable(CellstressError):
         self.residual = residual
         super().__init__(f"pose {index} is out of reach: the closest the arm gets is "
                          f"{residual[0] * 1000:.1f} mm and {np.rad2deg(residual[1]):.1f} deg away")
-
-
-@dataclass(frozen=True)
-class IkProblem:
-    jmap: JointMap
-    frame: str
 
 
 def _pose_error(pin, model, data, frame_id, q, target):
@@ -79,7 +72,7 @@ def _solve(pin, model, data, frame_id, e, jmap, target, seed, lo, hi):
 
 def solve_poses(jmap: JointMap, frame: str, targets: list[np.ndarray], seed: np.ndarray) -> np.ndarray:
     """Driven joint values (n, nd) for each 4x4 target of ``frame`` in the robot's base frame, in order."""
-    import pinocchio as pin
+    import pinocchio as pin  # heavy: imported only when a cell has poses (as robot.model does)
 
     robot = jmap.robot
     model = load_pinocchio(robot.urdf)
