@@ -2,7 +2,9 @@
 
 Usage: python scripts/ik_waypoints.py X Y Z [--seed q1,...,q6] [--base-yaw DEG]
 X, Y, Z: tool0 position in the robot base frame [m]; the tool points straight down.
-The built-in cells' waypoints were made with this script (see docs/cells.md).
+The built-in cells' waypoints were made with this script (see docs/cells.md). A cell file can now give the
+poses itself (robot.task.poses and tool_frame, solved when the cell is loaded: docs/cell-format.md); this
+script stays as the record of how the built-in waypoints were made.
 """
 
 from __future__ import annotations

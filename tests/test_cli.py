@@ -77,8 +77,9 @@ def test_cells_lists_every_builtin(capsys) -> None:
     code, out, err = _run(["cells"], capsys)
     assert code == 0 and err == ""
     lines = out.strip().splitlines()
-    assert [ln.split()[0] for ln in lines[:-1]] == list(BUILTIN_CELLS)
-    assert lines[-1].startswith("files in ")  # where the built-in cell files are
+    assert [ln.split()[0] for ln in lines[:-2]] == list(BUILTIN_CELLS)
+    assert lines[-2].startswith("files in ")  # where the built-in cell files are
+    assert lines[-1].startswith("robots: ur3, ur5, ur10") and "panda" in lines[-1]
     baseline_line = lines[0]
     assert len(baseline_line.split()) > 1  # a description follows the name
 

@@ -148,6 +148,26 @@ def _named_start(xy) -> Callable[[dict], None]:
     return change
 
 
+def _write(rel: str, data: bytes) -> Callable[[Path], None]:
+    def setup(folder: Path) -> None:
+        (folder / rel).parent.mkdir(parents=True, exist_ok=True)
+        (folder / rel).write_bytes(data)
+
+    return setup
+
+
+def _task(**task) -> Callable[[dict], None]:
+    def change(cell: dict) -> None:
+        cell["robot"]["task"] = task
+
+    return change
+
+
+_CSV_HEAD = b"time,q1,q2,q3,q4,q5,q6\n0,1.4,-0.8,1.3,-2.1,-1.57,0\n"
+_ENTITY_BOMB = (b'<?xml version="1.0"?><!DOCTYPE r [<!ENTITY a "aaaaaaaaaa">'
+                + b"".join(f'<!ENTITY {chr(98 + i)} "{("&" + chr(97 + i) + ";") * 10}">'.encode() for i in range(8))
+                + b']><robot name="r"><link name="&i;"/></robot>')
+
 # ---- cell files that must be refused (exit 2), by every command that reads a cell ---------------------------
 BAD_CELLS: list[tuple[str, dict, tuple[str, ...]]] = [
     ("fifo", {"setup": _fifo(CELL)}, ("cell.yaml", "not a regular file")),
@@ -188,6 +208,24 @@ BAD_CELLS: list[tuple[str, dict, tuple[str, ...]]] = [
     ("unknown-device", {"cell": _set("devices[0].type", "laser-cannon")}, ("devices",)),
     ("urdf-etc-passwd", {"cell": _set("robot.urdf", "/etc/passwd")}, ("robot.urdf",)),
     ("urdf-fifo", {"cell": _set("robot.urdf", "pipe.urdf"), "setup": _fifo("in/pipe.urdf")}, ("robot.urdf",)),
+    ("urdf-short-name-unknown", {"cell": _set("robot.urdf", "kuka")}, ("robot.urdf", "neither a built-in robot")),
+    ("urdf-entity-bomb", {"cell": _set("robot.urdf", "bomb.urdf"), "setup": _write("in/bomb.urdf", _ENTITY_BOMB)},
+     ("robot.urdf",)),
+    ("waypoint-beyond-limit", {"cell": _set("robot.task.waypoints_deg[1][2]", 900.0)},
+     ("waypoints_deg[1][2]", "elbow_joint", "limits")),
+    ("csv-fifo", {"cell": _task(trajectory_csv="q.csv"), "setup": _fifo("in/q.csv")},
+     ("trajectory_csv", "not a regular file")),
+    ("csv-not-a-number", {"cell": _task(trajectory_csv="q.csv"),
+                          "setup": _write("in/q.csv", _CSV_HEAD + b"1,1.4,-0.8,1e999,-2.1,-1.57,0\n")},
+     ("trajectory_csv", "row 3, column 4")),
+    ("csv-many-rows", {"cell": _task(trajectory_csv="q.csv"),
+                       "setup": _write("in/q.csv", _CSV_HEAD + b"0,0,0,0,0,0,0\n" * 300_000)},
+     ("trajectory_csv", "more than 200,000 rows")),
+    ("csv-binary", {"cell": _task(trajectory_csv="q.csv"), "setup": _write("in/q.csv", bytes(range(256)) * 64)},
+     ("trajectory_csv",)),
+    ("ik-pose-far-away", {"cell": _task(tool_frame="tool0", poses=[{"xyz": [0.5, 0.5, 1.0], "rpy_deg": [180, 0, 0]},
+                                                                   {"xyz": [50.0, 0, 1], "rpy_deg": [0, 0, 0]}])},
+     ("robot.task.poses[1]", "cannot be reached")),
     ("python-tag", {"cell_bytes": b"!!python/object/apply:os.system ['touch pwned']\n"}, ("cell.yaml",)),
     ("list-at-top", {"cell_bytes": b"- a\n- b\n"}, ("cell.yaml",)),
 ]

@@ -75,3 +75,22 @@ def test_cells_and_check_say_where_the_files_are(capsys) -> None:
     assert str(Path(builtin_file("baseline")).parent) in capsys.readouterr().out
     assert main(["check", "baseline"]) == 0
     assert f"(built-in: {builtin_file('baseline')}, sha256" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("robot", ["panda", "ur5", "z1", "kinova"])
+def test_new_with_a_robot_writes_a_starter_that_passes_check(robot, tmp_path, capsys, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main(["new", "cell", "--robot", robot]) == 0
+    text = (tmp_path / "cell.yaml").read_text()
+    assert yaml.safe_load(text)["robot"]["urdf"] == robot
+    jsonschema.validate(yaml.safe_load(text), json_schema())
+    capsys.readouterr()
+    assert main(["check", "cell.yaml"]) == 0
+    assert capsys.readouterr().out.strip().endswith("PASS: the cell file is valid and the static check passes")
+
+
+def test_new_refuses_an_unknown_robot(tmp_path, capsys, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main(["new", "cell", "--robot", "kuka"]) == 2
+    assert "not a built-in robot (ur3, ur5, ur10" in capsys.readouterr().err
+    assert not (tmp_path / "cell.yaml").exists()

@@ -155,8 +155,8 @@ def test_joint_trajectory_matches_reference(setup):
     q, qd = np.zeros(6), np.zeros(6)
     taus = np.concatenate([
         rng.uniform(-traj.cycle, 3 * traj.cycle, 2000),
-        traj.starts, traj.starts + traj.dwell, traj.starts + traj.dwell + traj.move_times,  # the joins
-        traj.starts + traj.dwell + 0.5 * traj.move_times,  # peak speed
+        traj.starts, traj.starts + traj.dwells, traj.starts + traj.dwells + traj.move_times,  # the joins
+        traj.starts + traj.dwells + 0.5 * traj.move_times,  # peak speed
     ])
     for tau in taus:
         sigma = rng.uniform(0.0, 1.0)
@@ -172,11 +172,11 @@ def test_trajectory_visits_the_waypoints(setup):
     wp = np.deg2rad(np.asarray(sim.cell.spec.robot.task.waypoints_deg, float))
     q, qd = np.zeros(6), np.zeros(6)
     for i, start in enumerate(traj.starts):
-        for tau in (start, start + 0.5 * traj.dwell):  # during the dwell
+        for tau in (start, start + 0.5 * traj.dwells[i]):  # during the dwell
             K.joint_trajectory(P, tau, 1.0, q, qd)
             np.testing.assert_allclose(q, wp[i], atol=1e-12)
             np.testing.assert_array_equal(qd, 0.0)
-        K.joint_trajectory(P, start + traj.dwell + traj.move_times[i] * (1 - 1e-12), 1.0, q, qd)
+        K.joint_trajectory(P, start + traj.dwells[i] + traj.move_times[i] * (1 - 1e-12), 1.0, q, qd)
         np.testing.assert_allclose(q, wp[(i + 1) % len(wp)], atol=1e-9)
 
 
@@ -201,8 +201,8 @@ def test_trajectory_velocity_is_continuous(setup):
     assert np.abs(np.diff(Q, axis=0)).max() <= np.abs(QD).max() * dt * (1 + 1e-6)
     # and the one-sided limits at every join agree (both zero: moves start and end at rest)
     eps = 1e-7
-    for start, move in zip(traj.starts, traj.move_times, strict=True):
-        for join in (start, start + traj.dwell, start + traj.dwell + move):
+    for start, dwell, move in zip(traj.starts, traj.dwells, traj.move_times, strict=True):
+        for join in (start, start + dwell, start + dwell + move):
             for tau in (join - eps, join + eps):
                 K.joint_trajectory(P, tau, 1.0, q, qd)
                 assert np.abs(qd).max() < 1e-9
@@ -215,7 +215,7 @@ def test_peak_joint_speed_respects_scaled_limits(setup):
     vmax = sim.layout.robot.velocity_limits
     limit = scale * vmax
     q, qd = np.zeros(6), np.zeros(6)
-    mid = traj.starts + traj.dwell + 0.5 * traj.move_times  # where each move peaks
+    mid = traj.starts + traj.dwells + 0.5 * traj.move_times  # where each move peaks
     taus = np.concatenate([np.linspace(0.0, traj.cycle, 20001), mid])
     peak = np.zeros(6)
     for tau in taus:
@@ -226,5 +226,5 @@ def test_peak_joint_speed_respects_scaled_limits(setup):
     for i, start in enumerate(traj.starts):
         if traj.move_times[i] <= MIN_SEGMENT_TIME:
             continue
-        K.joint_trajectory(P, start + traj.dwell + 0.5 * traj.move_times[i], 1.0, q, qd)
+        K.joint_trajectory(P, start + traj.dwells[i] + 0.5 * traj.move_times[i], 1.0, q, qd)
         assert np.max(np.abs(qd) / limit) == pytest.approx(1.0, rel=1e-9)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import difflib
 import hashlib
-import math
 import re
 import reprlib
 import types
@@ -16,14 +15,14 @@ from pathlib import Path
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from cellstress.cell.schema import CRITERIA, DEVICE_KINDS, MAX_CYCLE, CellSpec
+from cellstress.cell.program import robot_program
+from cellstress.cell.schema import CRITERIA, DEVICE_KINDS, CellSpec
 from cellstress.core import registry
 from cellstress.core.errors import CellError, CellstressError
 from cellstress.core.io import MAX_INPUT_BYTES, InputFileError, read_input_bytes
 from cellstress.core.plane import point_segment_distance, polygon_distance
 from cellstress.human.body import BODY_RADIUS, WALK_BLOCK_HEIGHT
-from cellstress.robot.model import load_robot, resolve_urdf
-from cellstress.robot.trajectory import build_trajectory
+from cellstress.robot.model import load_robot, resolve_urdf, unknown_urdf_message
 
 BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap", "all-flaws",
                                   "s2-deceptive")
@@ -328,34 +327,19 @@ def load_cell(name_or_path: str | Path) -> Cell:
 
 
 def check_geometry(cell: Cell) -> None:
-    """Checks that need more than one field: the URDF, the waypoints against its joints and their limits, the
-    robot's cycle time, the start pose and every named start point."""
+    """Checks that need more than one field: the URDF, the robot's program against its joints and their
+    position and velocity limits, the robot's cycle time, the start pose and every named start point."""
     spec, src = cell.spec, cell.source
     urdf = resolve_urdf(spec.robot.urdf, cell.directory)
     if not urdf.is_file():
-        raise CellError(src, "robot.urdf", f"URDF file not found: {urdf}")
+        raise CellError(src, "robot.urdf", unknown_urdf_message(spec.robot.urdf, urdf))
     try:
         robot = load_robot(urdf)
     except CellstressError as exc:
         raise CellError(src, "robot.urdf", str(exc)) from None
     except Exception as exc:  # pinocchio raises plain RuntimeError/ValueError for unreadable URDFs
         raise CellError(src, "robot.urdf", f"pinocchio cannot read it: {str(exc).splitlines()[0]}") from None
-    nj = robot.n_joints
-    task = spec.robot.task
-    for i, w in enumerate(task.waypoints_deg):
-        if len(w) != nj:
-            raise CellError(src, f"robot.task.waypoints_deg[{i}]",
-                            f"has {len(w)} joint values but the robot has {nj} joints")
-        for j, deg in enumerate(w):
-            lo, hi = math.degrees(robot.lower[j]), math.degrees(robot.upper[j])
-            if not lo - 1e-6 <= deg <= hi + 1e-6:
-                raise CellError(src, f"robot.task.waypoints_deg[{i}][{j}]",
-                                f"{deg:g} deg is outside joint {robot.joint_names[j]!r}'s limits "
-                                f"{lo:.1f}..{hi:.1f} deg")
-    cycle = build_trajectory(task.waypoints_deg, task.dwell, task.speed_scale, robot.velocity_limits).cycle
-    if cycle > MAX_CYCLE:
-        raise CellError(src, "robot.task", f"the cycle takes {cycle:.0f} s; at most {MAX_CYCLE:.0f} s "
-                                           "(raise speed_scale, shorten dwell)")
+    robot_program(src, robot, spec.robot, cell.directory)
     caps = spec.robot.capsules if spec.robot.capsules != "auto" else ()
     for i, c in enumerate(tuple(caps) + spec.robot.extra_capsules):
         if c.link not in robot.link_joint:

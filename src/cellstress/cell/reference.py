@@ -30,6 +30,34 @@ docs/cells.md explains their numbers.
 
 This page is generated from the schema (`cellstress schema --markdown`); the device and criterion kinds are
 those installed (plug-ins add theirs: docs/extending.md).
+
+## Robots and their programs
+
+`robot.urdf` is a short name of example-robot-data (`cellstress cells` lists them: ur3, ur5, ur10, panda, kinova,
+xarm7, ...) or a URDF file: any serial chain of revolute, continuous and prismatic joints, fixed joints and
+`<mimic>` joints included. Joint values are degrees, or metres for a prismatic joint. A program gives one value
+per *driven* joint: every joint but the `<mimic>` ones (they follow their master) and those in `robot.hold`.
+Every value is checked against the URDF's position limits, and a trajectory file also against its velocity
+limits. `cellstress new NAME --robot panda` writes a starter cell.
+The program takes one of three forms:
+
+```yaml
+robot:
+  urdf: panda
+  hold: [{joint: panda_finger_joint1, value: 0.02}]   # fingers 4 cm apart; finger 2 mimics finger 1
+  task:
+    # (a) joint waypoints, minimum-jerk moves; optionally a speed and a dwell per move
+    waypoints_deg: [[0, -20, 0, -120, 0, 100, 45], [60, -20, 0, -120, 0, 100, 45]]
+    speed_scales: [0.5, 0.2]
+    dwells: [0.5, 0.2]
+    # (b) or tool poses in the cell's frame, solved by inverse kinematics when the cell is loaded
+    # tool_frame: panda_hand
+    # poses:
+    #   - {xyz: [-0.55, 0.45, 1.05], rpy_deg: [180, 0, 0]}
+    #   - {xyz: [0.55, 0.45, 1.05], rpy_deg: [180, 0, 0]}
+    # (c) or a joint-trajectory file (relative to the cell file), played linearly at its own timing:
+    # trajectory_csv: pick.csv      # header time,q1,...,q7 (or the joint names); radians unless csv_degrees
+```
 """
 
 

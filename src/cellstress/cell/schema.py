@@ -72,16 +72,67 @@ class CapsuleSpec(Record):
     """Radius [m]."""
 
 
+class ToolPose(Record):
+    """A Cartesian waypoint: where the robot's tool frame should be, in the cell's frame (solved by inverse
+    kinematics when the cell is loaded)."""
+
+    xyz: Point3
+    """Position of the tool frame's origin in the cell [m]."""
+    rpy_deg: tuple[Angle, Angle, Angle]
+    """Orientation of the tool frame in the cell [deg]: roll, pitch, yaw about the cell's fixed x, y, z axes
+    (the URDF convention). (0, 180, 0) points a tool's z axis straight down."""
+
+
+class HeldJoint(Record):
+    """A joint the program does not move, held at one value: e.g. a gripper's fingers at a set opening."""
+
+    joint: Name
+    """The URDF joint's name."""
+    value: JointAngle
+    """Its value: degrees for a revolute joint, metres for a prismatic one; within its limits."""
+
+
+SpeedScale = Annotated[float, Field(ge=0.01, le=1.0, allow_inf_nan=False)]
+Dwell = Annotated[float, Field(ge=0.0, le=60.0, allow_inf_nan=False)]
+PROGRAMS = ("waypoints_deg", "poses", "trajectory_csv")
+
+
 class TaskSpec(Record):
-    """A cyclic pick-and-place: joint waypoints visited in order, then back to the first."""
+    """The robot's cyclic program, in one of three forms: joint waypoints (``waypoints_deg``), tool poses
+    (``poses``, solved by inverse kinematics), each visited in order by minimum-jerk moves and then back to the
+    first; or a joint-trajectory file (``trajectory_csv``) played at its own timing."""
 
     waypoints_deg: tuple[Annotated[tuple[JointAngle, ...], Field(max_length=MAX_JOINTS)], ...] = \
-        Field(min_length=2, max_length=MAX_WAYPOINTS)
-    """Joint angles [deg] of each waypoint, one per revolute joint of the URDF, within its joint limits."""
-    dwell: Annotated[float, Field(ge=0.0, le=60.0, allow_inf_nan=False)] = 0.2
+        Field((), max_length=MAX_WAYPOINTS)
+    """Joint values of each waypoint (at least 2), one per joint the program drives (the URDF's joints
+    without its ``<mimic>`` joints and ``robot.hold``'s), in URDF order: degrees for revolute joints, metres
+    for prismatic ones; within the joints' limits."""
+    poses: tuple[ToolPose, ...] = Field((), max_length=MAX_WAYPOINTS)
+    """Tool poses to visit (at least 2), instead of ``waypoints_deg``: each is solved by inverse kinematics
+    within the joint limits, starting from the previous waypoint's solution (the first from ``ik_seed_deg``),
+    so the arm keeps its configuration; a pose it cannot reach within 1 mm and 1 deg is an error."""
+    tool_frame: Name | None = None
+    """The URDF link or frame that ``poses`` place (e.g. panda_hand, tool0); required with ``poses``."""
+    ik_seed_deg: Annotated[tuple[JointAngle, ...], Field(max_length=MAX_JOINTS)] | None = None
+    """Where the search for the first pose starts: a value per driven joint, as in ``waypoints_deg``;
+    absent: the middle of each joint's range."""
+    trajectory_csv: Annotated[str, Field(min_length=1, max_length=1000, pattern=r"^[^\x00]+$")] | None = None
+    """A joint-trajectory file (as controllers and offline-programming tools export), instead of waypoints:
+    CSV with a header ``time`` then one column per driven joint (``q1, q2, ...`` or the joint names, in URDF
+    order), a row per sample; times [s] strictly increasing; joint values in radians (metres for prismatic
+    joints) unless ``csv_degrees``. The robot moves at constant speed between rows and its last row must
+    repeat the first (the cycle restarts). Path relative to the cell file; at most 200,000 rows and 20 MB."""
+    csv_degrees: bool = False
+    """The trajectory file's revolute joint values are in degrees (not radians)."""
+    dwell: Dwell = 0.2
     """Pause at each waypoint [s]."""
-    speed_scale: Annotated[float, Field(ge=0.01, le=1.0, allow_inf_nan=False)] = 0.5
+    dwells: tuple[Dwell, ...] | None = None
+    """A pause per waypoint [s], instead of ``dwell``."""
+    speed_scale: SpeedScale = 0.5
     """Fraction of the joints' velocity limits used between waypoints (minimum-jerk moves)."""
+    speed_scales: tuple[SpeedScale, ...] | None = None
+    """A ``speed_scale`` per move, instead of one for all: move i goes from waypoint i to the next (the last
+    one back to the first), so as many values as waypoints."""
     phase: Annotated[float, Field(ge=0.0, le=3600.0, allow_inf_nan=False)] = 0.0
     """The robot's time in its cycle [s] when an episode starts: the moment at which the worker arrives."""
 
@@ -89,12 +140,36 @@ class TaskSpec(Record):
     @classmethod
     def _same_length(cls, v: tuple[tuple[float, ...], ...]) -> tuple[tuple[float, ...], ...]:
         lengths = {len(w) for w in v}
-        if len(lengths) != 1:
+        if len(lengths) > 1:
             raise ValueError(f"all waypoints need the same number of joints, got lengths {sorted(lengths)}")
         for w in v:
             if not all(math.isfinite(x) for x in w):
                 raise ValueError("waypoints must be finite numbers")
         return v
+
+    @model_validator(mode="after")
+    def _one_program(self) -> TaskSpec:
+        given = [name for name in PROGRAMS if getattr(self, name)]
+        if len(given) != 1:
+            got = f"got {' and '.join(given)}" if given else "got none"
+            raise ValueError(f"give exactly one program: waypoints_deg, poses or trajectory_csv ({got})")
+        count = len(self.waypoints_deg) or len(self.poses)
+        if given[0] != "trajectory_csv" and count < 2:
+            raise ValueError(f"{given[0]} needs at least 2 waypoints, got {count}")
+        if self.poses and self.tool_frame is None:
+            raise ValueError("poses need tool_frame: the URDF link they place (e.g. tool0)")
+        for name, needs in (("tool_frame", "poses"), ("ik_seed_deg", "poses"), ("csv_degrees", "trajectory_csv")):
+            if getattr(self, name) not in (None, False) and not getattr(self, needs):
+                raise ValueError(f"{name} is for a program of {needs}; this one has none")
+        for name in ("speed_scales", "dwells"):
+            values = getattr(self, name)
+            if values is None:
+                continue
+            if given[0] == "trajectory_csv":
+                raise ValueError(f"{name} is for waypoint programs; a trajectory file has its own timing")
+            if len(values) != count:
+                raise ValueError(f"{name} has {len(values)} value(s); give one per waypoint ({count})")
+        return self
 
 
 def _capsules_kind(v: object) -> str:
@@ -113,8 +188,9 @@ class RobotSpec(Record):
     """The robot: a serial chain from a URDF, placed in the cell, with its collision capsules and its program."""
 
     urdf: Annotated[str, Field(min_length=1, max_length=1000, pattern=r"^[^\x00]+$")] = "ur10"
-    """A robot of example-robot-data by its short name (ur10) or the path of a URDF file, relative to the cell
-    file."""
+    """A robot of example-robot-data by its short name (ur3, ur5, ur10, ur3-gripper, ur5-gripper, panda,
+    kinova, xarm7, z1, so100, so101) or the path of a URDF file, relative to the cell file: a serial chain of
+    revolute, continuous and prismatic joints (fixed and ``<mimic>`` joints too), with velocity limits."""
     base: Pose = Pose()
     """The base frame in the cell."""
     capsules: CapsulesField = "auto"
@@ -126,8 +202,19 @@ class RobotSpec(Record):
     pedestal: Literal["auto", "none"] = "auto"
     """auto: the robot's base (its base link's collision mesh in plan, from the floor up to the base link's top)
     is an obstacle the worker cannot walk or lean into; none: nothing below the base (a robot hung from above)."""
+    hold: tuple[HeldJoint, ...] = Field((), max_length=MAX_JOINTS)
+    """Joints the program does not drive, each held at a value (a gripper at a set opening)."""
     task: TaskSpec
     """The robot's cyclic program."""
+
+    @field_validator("hold")
+    @classmethod
+    def _hold_once(cls, v: tuple[HeldJoint, ...]) -> tuple[HeldJoint, ...]:
+        names = [h.joint for h in v]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise ValueError(f"a joint is held once: {', '.join(dup)} appears more than once")
+        return v
 
 
 class TableSpec(Record):

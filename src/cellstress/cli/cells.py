@@ -7,12 +7,14 @@ from cellstress.core.errors import CellstressError
 
 
 def cells() -> None:
-    """List the built-in cells with the first sentence of each description, and where their files are."""
+    """List the built-in cells with the first sentence of each description, where their files are, and the
+    built-in robots."""
     import os
 
     import yaml
 
     from cellstress.cell.load import BUILTIN_CELLS, builtin_file, builtin_text
+    from cellstress.robot.model import BUILTIN_ROBOTS
 
     width = max(len(n) for n in BUILTIN_CELLS)
     for name in BUILTIN_CELLS:
@@ -28,3 +30,5 @@ def cells() -> None:
         say(f"{name:<{width}}  {first_sentence(str(description or '')) or '(no description)'}")
     say(f"files in {os.path.dirname(builtin_file(BUILTIN_CELLS[0]))} (NAME.yaml; docs/cell-format.md describes "
         "every field, 'cellstress new NAME' writes a starter cell)")
+    say(f"robots: {', '.join(BUILTIN_ROBOTS)} (robot.urdf short names, from example-robot-data; "
+        "'cellstress new NAME --robot panda' writes a starter cell with one)")

@@ -20,9 +20,9 @@ def check(
 
     from cellstress.analysis.iso13855 import check_cell
     from cellstress.cell.load import BUILTIN_CELLS, builtin_file, load_cell
+    from cellstress.cell.program import robot_program
     from cellstress.robot.capsules import declared_capsule, fitted_capsules
     from cellstress.robot.model import load_robot, resolve_urdf
-    from cellstress.robot.trajectory import build_trajectory
     from cellstress.sim.build import pedestal
 
     with spinner_while_compiling(), user_errors():
@@ -41,7 +41,7 @@ def check(
         for i, k in enumerate(spec.robot.extra_capsules):
             caps.append(declared_capsule(robot, f"{k.link}#extra{i}", k.link, k.p0, k.p1, k.radius))
         task = spec.robot.task
-        traj = build_trajectory(task.waypoints_deg, task.dwell, task.speed_scale, robot.velocity_limits)
+        traj = robot_program(c.source, robot, spec.robot, c.directory)
         static = check_cell(c)
 
     out = say
@@ -51,15 +51,26 @@ def check(
         out(f"            {first_sentence(spec.description)}")
     base = spec.robot.base
     out(f"robot       {spec.robot.urdf} -> {urdf}")
-    out(f"            {robot.n_joints} joints, base at ({', '.join(num(v) for v in base.xyz)}) "
+    n_mimic = int((robot.mimic_master >= 0).sum())
+    follow = [f"{n} {what}" for n, what in ((len(spec.robot.hold), "held"), (n_mimic, "mimic")) if n]
+    joints = f"{robot.n_joints} joints" + (f" ({', '.join(follow)})" if follow else "")
+    out(f"            {joints}, base at ({', '.join(num(v) for v in base.xyz)}) "
         f"yaw {num(base.yaw_deg)} deg, stopping time {num(spec.robot.stopping_time)} s")
     extra = f" + {len(caps) - n_own} extra" if len(caps) > n_own else ""
     out(f"capsules    {len(caps)} ({n_own} {cap_kind}{extra})")
     for k in caps:
         length = float(np.linalg.norm(np.subtract(k.p1, k.p0)))
         out(f"            {k.name:<18} on joint {k.joint:>2}  radius {k.radius:.3f} m  length {length:.3f} m")
-    out(f"task        {len(task.waypoints_deg)} waypoints, dwell {num(task.dwell)} s, speed scale "
-        f"{num(task.speed_scale)}, phase {num(task.phase)} s, cycle time {traj.cycle:.2f} s")
+    if task.trajectory_csv:
+        out(f"task        trajectory file {task.trajectory_csv}, {traj.n_segments + 1} rows, linear moves, "
+            f"phase {num(task.phase)} s, cycle time {traj.cycle:.2f} s")
+    else:
+        what = f"{len(task.poses)} tool poses of {task.tool_frame}" if task.poses else \
+            f"{len(task.waypoints_deg)} waypoints"
+        dwell = "per waypoint" if task.dwells else f"{num(task.dwell)} s"
+        scale = "per move" if task.speed_scales else num(task.speed_scale)
+        out(f"task        {what}, dwell {dwell}, speed scale {scale}, phase {num(task.phase)} s, "
+            f"cycle time {traj.cycle:.2f} s")
     obstacles = spec.solid_obstacles() + tuple(p for p in (pedestal(spec, robot),) if p is not None)
     out(f"obstacles   {len(obstacles)}" + ("" if obstacles else " (nothing on the floor)"))
     for o in obstacles:

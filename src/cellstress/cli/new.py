@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import textwrap
 from pathlib import Path
 from typing import Annotated
 
@@ -19,10 +20,55 @@ HEADER = """\
 """
 
 
+def robot_block(short_name: str) -> str:
+    """The ``robot:`` section of a starter cell for a built-in robot: joint waypoints derived from its joint
+    limits (the middle of every range, then the first joint turned by a quarter of its range, at most 90 deg),
+    so the program is within limits for any arm; the user replaces them with the cell's own."""
+    import numpy as np
+
+    from cellstress.robot.joints import joint_map, user_value
+    from cellstress.robot.model import load_robot, resolve_urdf
+
+    robot = load_robot(resolve_urdf(short_name, None))
+    jmap = joint_map(robot, {})
+    lo, hi = robot.sampling_range()
+    mid = 0.5 * (lo + hi)
+    turned = mid.copy()
+    j0 = jmap.driven[0]
+    turned[j0] += min(0.25 * (hi[j0] - lo[j0]), float(np.deg2rad(90.0)))
+
+    def row(q) -> str:
+        # rounded to 0.1 deg / 0.1 mm: the middle of a range and a quarter of it stay well within the limits
+        digits = {j: 1 if robot.unit(j) == "deg" else 4 for j in jmap.driven}
+        return "[" + ", ".join(f"{round(user_value(robot, j, q[j]), digits[j]):g}" for j in jmap.driven) + "]"
+
+    names = textwrap.fill(", ".join(jmap.driven_names), 100, initial_indent="    # ", subsequent_indent="    # ")
+    return f"""robot:
+  urdf: {short_name}
+  base: {{xyz: [0.0, 0.0, 0.85], yaw_deg: 0.0}}
+  capsules: auto
+  stopping_time: 0.15
+  task:
+    # one value per joint the program drives, in degrees (metres for a prismatic joint):
+{names}
+    # A starting point within the joint limits: replace it by the cell's own program (or give tool poses:
+    # poses + tool_frame; or a joint-trajectory file: trajectory_csv; see docs/cell-format.md)
+    waypoints_deg:
+      - {row(mid)}
+      - {row(turned)}
+    dwell: 0.2
+    speed_scale: 0.5
+    phase: 1.4
+"""
+
+
 def new(
     name: Annotated[str, typer.Argument(help="The new cell's name (letters, digits, '. _ -').")],
     out: Annotated[str | None, typer.Option("--out", "-o", help="The file to write (default: NAME.yaml in the "
                                             "current folder); an existing file is never overwritten.")] = None,
+    robot: Annotated[str | None, typer.Option("--robot", help="A built-in robot for the cell (ur3, ur5, ur10, "
+                                              "panda, ...: 'cellstress cells' lists them); default: the "
+                                              "baseline's UR10 and its program.")] = None,
 ) -> None:
     """Write a commented starter cell (a copy of the built-in 'baseline' under a new name) that passes 'check'."""
 
@@ -30,6 +76,7 @@ def new(
 
     from cellstress.cell.load import builtin_text, parse_cell
     from cellstress.core.io import atomic_write_text
+    from cellstress.robot.model import BUILTIN_ROBOTS
 
     if not re.fullmatch(r"[A-Za-z0-9_.-]{1,100}", name) or name.strip(".") == "":
         raise fail(f"NAME {name!r}: use 1 to 100 letters, digits, '.', '_' or '-'")
@@ -38,8 +85,16 @@ def new(
         raise fail(f"--out {out}: a cell file's name ends in .yaml")
     if path.exists() or path.is_symlink():
         raise fail(f"{path}: exists; give another --out (nothing was written)")
+    if robot is not None and robot not in BUILTIN_ROBOTS:
+        raise fail(f"--robot {robot}: not a built-in robot ({', '.join(BUILTIN_ROBOTS)}); for a URDF file of "
+                   "your own, write its path into robot.urdf")
     text = builtin_text("baseline")
     body = text[text.index("\nname:") + 1:]  # the built-in's own header comment is replaced
+    if robot not in (None, "ur10"):  # (the baseline's own robot keeps its program)
+        body = body.replace("a UR10 on the base", f"a robot ({robot}) on the base", 1)
+        with user_errors():
+            block = robot_block(robot)
+        body = body[:body.index("robot:\n")] + block + body[body.index("table:\n"):]
     body = body.replace("name: baseline\n", f"name: {yaml.safe_dump(name).splitlines()[0]}\n", 1)
     # a new cell is searched over the robot's whole cycle (the built-in keeps the paper's fixed arrival)
     body = re.sub(r"(?m)^  arrival: fixed .*$", "  arrival: cycle    # any moment of the robot's cycle, chosen by the "

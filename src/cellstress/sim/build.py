@@ -8,14 +8,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from cellstress.cell.load import Cell
+from cellstress.cell.program import held_joints, robot_program
 from cellstress.cell.schema import ObstacleSpec
 from cellstress.core.records import ScanPlane, VerticalField
 from cellstress.human.actions import action_table
 from cellstress.human.body import BodyDimensions
 from cellstress.human.reach import ReachField, reach_field
 from cellstress.robot.capsules import Capsule, base_footprint, declared_capsule, fitted_capsules
-from cellstress.robot.model import RobotModel, load_robot, resolve_urdf
-from cellstress.robot.trajectory import Trajectory, build_trajectory
+from cellstress.robot.joints import JointMap
+from cellstress.robot.model import PRISMATIC, RobotModel, base_matrix, load_robot, resolve_urdf
+from cellstress.robot.trajectory import Trajectory
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 
@@ -78,6 +80,7 @@ class Layout:
     reach: ReachField
     device_names: tuple[str, ...]
     params: K.SimParams
+    joints: JointMap  # the joints the program drives; the others are held or mimic ones
     obstacles: tuple[ObstacleSpec, ...] = ()  # the table's polygons, the cell's obstacles, the robot's pedestal
 
 
@@ -89,7 +92,7 @@ def pedestal(spec, robot: RobotModel) -> ObstacleSpec | None:
     if spec.robot.pedestal == "none":
         return None
     hull, top = base_footprint(robot)
-    m = _base_matrix(spec.robot.base.xyz, spec.robot.base.yaw_deg)
+    m = base_matrix(spec.robot.base.xyz, spec.robot.base.yaw_deg)
     world = hull @ m[:2, :2].T + m[:2, 3]
     height = float(m[2, 3]) + top
     if height <= 0.0:
@@ -107,13 +110,6 @@ def obstacle_arrays(obstacles) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return verts, index, box
 
 
-def _base_matrix(xyz, yaw_deg) -> np.ndarray:
-    c, s = np.cos(np.deg2rad(yaw_deg)), np.sin(np.deg2rad(yaw_deg))
-    m = np.eye(4)
-    m[:3, :3] = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
-    m[:3, 3] = xyz
-    return m
-
 
 def build_layout(cell: Cell) -> Layout:
     spec = cell.spec
@@ -125,7 +121,7 @@ def build_layout(cell: Cell) -> Layout:
     for i, c in enumerate(spec.robot.extra_capsules):
         caps.append(declared_capsule(robot, f"{c.link}#extra{i}", c.link, c.p0, c.p1, c.radius))
     task = spec.robot.task
-    traj = build_trajectory(task.waypoints_deg, task.dwell, task.speed_scale, robot.velocity_limits)
+    traj = robot_program(cell.source, robot, spec.robot, cell.directory)
     anth = spec.human.anthropometry
     body = BodyDimensions(anth.height, anth.upper_arm, anth.forearm, anth.hand, spec.human.walking_speed)
     reach = reach_field(anth.upper_arm, anth.forearm, anth.hand)
@@ -151,7 +147,7 @@ def build_layout(cell: Cell) -> Layout:
     scal[L.C_STOP_TIME] = spec.robot.stopping_time
     scal[L.C_PHASE0] = task.phase
     scal[L.C_CYCLE] = traj.cycle
-    scal[L.C_DWELL] = traj.dwell
+    scal[L.C_LINEAR] = 1.0 if traj.linear else 0.0
     # a criterion without a kernel fast path: the kernel latches no contact (it may be safe), the Simulator judges
     fast = spec.criterion.kernel_test()
     scal[L.C_DTOL] = spec.criterion.distance_tolerance if fast is None else fast.distance_tolerance
@@ -164,14 +160,17 @@ def build_layout(cell: Cell) -> Layout:
         spa=int(spec.simulation.steps_per_action),
         act=action_table(spec.human.max_forward_flexion_deg, spec.human.max_lateral_flexion_deg),
         body=body.params(),
-        base=_base_matrix(spec.robot.base.xyz, spec.robot.base.yaw_deg),
+        base=base_matrix(spec.robot.base.xyz, spec.robot.base.yaw_deg),
         parents=robot.parents.astype(np.int64),
         placements=np.ascontiguousarray(robot.placements),
         axes=np.ascontiguousarray(robot.axes),
+        jtype=np.asarray([L.JOINT_PRISMATIC if k == PRISMATIC else L.JOINT_REVOLUTE for k in robot.kinds],
+                         dtype=np.int64),
         anc=anc,
         wp=np.ascontiguousarray(traj.waypoints),
         seg_start=traj.starts.astype(float),
         seg_move=traj.move_times.astype(float),
+        seg_dwell=traj.dwells.astype(float),
         cap_joint=np.asarray([c.joint for c in caps], dtype=np.int64),
         cap_a=np.asarray([c.p0 for c in caps], dtype=float).reshape(-1, 3),
         cap_b=np.asarray([c.p1 for c in caps], dtype=float).reshape(-1, 3),
@@ -193,7 +192,8 @@ def build_layout(cell: Cell) -> Layout:
         pre_tau=np.zeros(0),
     )
     params = _with_robot_table(params, spec)
-    return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params, obstacles)
+    joints = held_joints(cell.source, robot, spec.robot)
+    return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params, joints, obstacles)
 
 
 def _with_robot_table(params: K.SimParams, spec) -> K.SimParams:

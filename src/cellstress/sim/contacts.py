@@ -33,6 +33,10 @@ class ContactModel:
         P = layout.params
         self.R_base = np.asarray(P.base[:3, :3])
         self.t_base = np.asarray(P.base[:3, 3])
+        # held joints are locked and a mimic joint moves with its master: the inertia the worker feels is that
+        # of the driven joints only (None: every joint is driven, nothing to reduce)
+        jm = layout.joints
+        self.reduce = None if len(jm.driven) == layout.robot.n_joints else jm.jacobian_map()
 
     def contact(self, row: np.ndarray) -> Contact:
         """The closest points of a metric row, with the region, normal, v_rel and reflected mass there."""
@@ -51,8 +55,12 @@ class ContactModel:
         else:
             pb = self.R_base.T @ (rp - self.t_base)  # pinocchio works in the robot base frame
             nb = self.R_base.T @ n
-            Jp, M = point_dynamics(self.model, self.data, q, j + 1, pb)
-            m_r = reflected_mass(Jp, M, nb)
+            Jp, M = point_dynamics(self.model, self.data, lay.robot.pinocchio_q(q), j + 1, pb)
+            if self.reduce is None:
+                m_r = reflected_mass(Jp, M, nb)
+            else:
+                e = self.reduce
+                m_r = reflected_mass(Jp @ e, e.T @ M @ e, nb)
             v_rel = max(0.0, float(nb @ (Jp @ qd)))
         return Contact(float(row[L.M_D]), float(row[L.M_V]), lay.capsules[link].name, BODY_PARTS[part], region,
                        (float(rp[0]), float(rp[1]), float(rp[2])), (float(hp[0]), float(hp[1]), float(hp[2])),

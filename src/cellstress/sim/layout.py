@@ -91,14 +91,14 @@ SCALARS = VectorSpec("scalar parameters (SimParams.scal)", (
     ("STOP_TIME", "robot's stopping time: from full speed to standstill [s]"),
     ("PHASE0", "robot's path time when an episode starts [s]"),
     ("CYCLE", "robot's cycle time [s]"),
-    ("DWELL", "robot's dwell at each waypoint [s]"),
+    ("LINEAR", "1: the robot's moves are at constant speed (a trajectory file); 0: minimum-jerk"),
     ("DTOL", "contact distance of the criterion's kernel test [m]"),
     ("VTOL", "robot speed above which a contact is unsafe [m/s]; inf: the kernel judges no contact"),
     ("REACH_ORIGIN", "reach field: coordinate of its first grid node on every axis [m]"),
     ("REACH_H", "reach field: grid spacing [m]"),
 ))
-(C_DT, C_STOP_TIME, C_PHASE0, C_CYCLE, C_DWELL, C_DTOL, C_VTOL, C_REACH_ORIGIN, C_REACH_H) = SCALARS.indices(
-    "DT", "STOP_TIME", "PHASE0", "CYCLE", "DWELL", "DTOL", "VTOL", "REACH_ORIGIN", "REACH_H")
+(C_DT, C_STOP_TIME, C_PHASE0, C_CYCLE, C_LINEAR, C_DTOL, C_VTOL, C_REACH_ORIGIN, C_REACH_H) = SCALARS.indices(
+    "DT", "STOP_TIME", "PHASE0", "CYCLE", "LINEAR", "DTOL", "VTOL", "REACH_ORIGIN", "REACH_H")
 N_SCAL = SCALARS.size
 
 DEVICE_KINDS = VectorSpec("detection primitive kinds (SimParams.dev_kind)", (
@@ -106,6 +106,12 @@ DEVICE_KINDS = VectorSpec("detection primitive kinds (SimParams.dev_kind)", (
     ("CURTAIN", "vertical rectangle (dev_rect: x0 y0 x1 y1 bottom top)"),
 ))
 DEV_SCANNER, DEV_CURTAIN = DEVICE_KINDS.indices("SCANNER", "CURTAIN")
+
+JOINT_KINDS = VectorSpec("robot joint kinds (SimParams.jtype)", (
+    ("REVOLUTE", "turns by q [rad] about its axis"),
+    ("PRISMATIC", "slides by q [m] along its axis"),
+))
+JOINT_REVOLUTE, JOINT_PRISMATIC = JOINT_KINDS.indices("REVOLUTE", "PRISMATIC")
 
 # The worker's parts in the row's PART: the body capsules, then the two reach volumes.
 N_BODY_CAPSULES = N_CAPSULES

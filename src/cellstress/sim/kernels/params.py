@@ -20,10 +20,12 @@ class SimParams(NamedTuple):
     parents: np.ndarray  # (nj,) int64
     placements: np.ndarray  # (nj, 4, 4)
     axes: np.ndarray  # (nj, 3)
+    jtype: np.ndarray  # (nj,) int64, layout.JOINT_KINDS
     anc: np.ndarray  # (nj, nj) float: 1 where column joint moves row joint's origin
-    wp: np.ndarray  # (nw, nj) waypoints
-    seg_start: np.ndarray  # (nw,)
-    seg_move: np.ndarray  # (nw,)
+    wp: np.ndarray  # (nw, nj) waypoints, every joint (mimic and held ones included)
+    seg_start: np.ndarray  # (nw,) when segment i's dwell begins, strictly increasing from 0
+    seg_move: np.ndarray  # (nw,) its move's duration
+    seg_dwell: np.ndarray  # (nw,) its dwell at waypoint i before the move
     cap_joint: np.ndarray  # (nc,) int64, -1 = base
     cap_a: np.ndarray  # (nc, 3)
     cap_b: np.ndarray  # (nc, 3)

@@ -1,4 +1,5 @@
-"""The robot: its cyclic minimum-jerk path, forward kinematics, capsules and speed, at any time and stop.
+"""The robot: its cyclic path (minimum-jerk or linear moves), forward kinematics, capsules and speed, at any
+time and stop.
 
 The robot is a pure function of time and of the moment its stop takes effect: its path time advances one
 second per second until the stop, then slows linearly to a standstill within the stopping time, so
@@ -15,9 +16,10 @@ from cellstress.sim.kernels.params import make_work
 from cellstress.sim.layout import (
     C_CYCLE,
     C_DT,
-    C_DWELL,
+    C_LINEAR,
     C_PHASE0,
     C_STOP_TIME,
+    JOINT_PRISMATIC,
     PHASE_BRAKING,
     PHASE_PENDING,
     PHASE_RUNNING,
@@ -41,30 +43,46 @@ def path_time(scal, t, t_stop):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _joint_trajectory(scal, seg_start, seg_move, wp, tau, sigma, q, qd):
-    """Joint positions and velocities on the cyclic minimum-jerk path at path time tau."""
+def _segment(seg_start, tc):
+    """The last segment i with seg_start[i] <= tc (seg_start[0] = 0): a binary search, as a trajectory file
+    may have thousands of rows."""
+    lo, hi = 0, seg_start.shape[0]
+    while hi - lo > 1:
+        mid = (lo + hi) >> 1
+        if tc < seg_start[mid]:
+            hi = mid
+        else:
+            lo = mid
+    return lo
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _joint_trajectory(scal, seg_start, seg_move, seg_dwell, wp, tau, sigma, q, qd):
+    """Joint positions and velocities on the cyclic path at path time tau: segment i dwells at wp[i], then
+    moves to the next row by a minimum-jerk or (C_LINEAR) a constant-speed move."""
     cycle = scal[C_CYCLE]
-    dwell = scal[C_DWELL]
     tc = tau - cycle * np.floor(tau / cycle)
     nw = seg_start.shape[0]
-    i = nw - 1
-    for k in range(1, nw):
-        if tc < seg_start[k]:
-            i = k - 1
-            break
+    i = _segment(seg_start, tc)
     j = i + 1 if i + 1 < nw else 0
     T = seg_move[i]
-    u = (tc - seg_start[i] - dwell) / T
+    u = (tc - seg_start[i] - seg_dwell[i]) / T
+    linear = scal[C_LINEAR] != 0.0
     nj = q.shape[0]
-    if u <= 0.0:
+    # a linear move is under way at its first instant (u = 0): its rows carry no dwell
+    if u < 0.0 or (u == 0.0 and not linear):
         for k in range(nj):
             q[k] = wp[i, k]
             qd[k] = 0.0
         return
     if u > 1.0:
         u = 1.0
-    s = u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
-    ds = 30.0 * u * u * (1.0 - u) * (1.0 - u) / T * sigma
+    if linear:
+        s = u
+        ds = sigma / T
+    else:
+        s = u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
+        ds = 30.0 * u * u * (1.0 - u) * (1.0 - u) / T * sigma
     for k in range(nj):
         dq = wp[j, k] - wp[i, k]
         q[k] = wp[i, k] + s * dq
@@ -72,7 +90,7 @@ def _joint_trajectory(scal, seg_start, seg_move, wp, tau, sigma, q, qd):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _forward_kinematics(parents, placements, base, axes, q, rot, pos):
+def _forward_kinematics(parents, placements, base, axes, jtype, q, rot, pos):
     """World rotation and origin of every joint frame."""
     # (No temporary array and no row views: each would be allocated or reference-counted on every call.)
     nj = q.shape[0]
@@ -92,8 +110,12 @@ def _forward_kinematics(parents, placements, base, axes, q, rot, pos):
                 pr = base[r, k] if par < 0 else rot[par, r, k]
                 acc += pr * placements[j, k, 3]
             pos[j, r] = acc
-        # rotation about the joint axis (Rodrigues)
         kx, ky, kz = axes[j, 0], axes[j, 1], axes[j, 2]
+        if jtype[j] == JOINT_PRISMATIC:  # a slide by q along the axis; the frame keeps its rotation
+            for r in range(3):
+                pos[j, r] += (rot[j, r, 0] * kx + rot[j, r, 1] * ky + rot[j, r, 2] * kz) * q[j]
+            continue
+        # rotation about the joint axis (Rodrigues)
         c, s = np.cos(q[j]), np.sin(q[j])
         v = 1.0 - c
         r00, r01, r02 = c + kx * kx * v, kx * ky * v - kz * s, kx * kz * v + ky * s
@@ -107,18 +129,26 @@ def _forward_kinematics(parents, placements, base, axes, q, rot, pos):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _fastest_joint_speed(anc, axes, qd, rot, pos):
+def _fastest_joint_speed(anc, axes, jtype, qd, rot, pos):
     """v_R: the largest Cartesian speed of any joint origin (the paper's 'fastest robot joint')."""
     nj = qd.shape[0]
     best = 0.0
     for i in range(nj):
         vx = vy = vz = 0.0
-        for j in range(i):
-            if anc[i, j] == 0.0:
+        for j in range(i + 1):
+            # a joint's own turning does not move its origin; its own sliding does
+            if j == i and jtype[j] != JOINT_PRISMATIC:
+                continue
+            if j < i and anc[i, j] == 0.0:
                 continue
             wx = rot[j, 0, 0] * axes[j, 0] + rot[j, 0, 1] * axes[j, 1] + rot[j, 0, 2] * axes[j, 2]
             wy = rot[j, 1, 0] * axes[j, 0] + rot[j, 1, 1] * axes[j, 1] + rot[j, 1, 2] * axes[j, 2]
             wz = rot[j, 2, 0] * axes[j, 0] + rot[j, 2, 1] * axes[j, 1] + rot[j, 2, 2] * axes[j, 2]
+            if jtype[j] == JOINT_PRISMATIC:
+                vx += qd[j] * wx
+                vy += qd[j] * wy
+                vz += qd[j] * wz
+                continue
             dx, dy, dz = pos[i, 0] - pos[j, 0], pos[i, 1] - pos[j, 1], pos[i, 2] - pos[j, 2]
             vx += qd[j] * (wy * dz - wz * dy)
             vy += qd[j] * (wz * dx - wx * dz)
@@ -148,36 +178,37 @@ def _robot_capsules(cap_joint, cap_a, cap_b, base, rot, pos, ra, rb):
 def robot_live(P, t, t_stop, W):
     """Pose the robot at time t: capsules into W.ra/W.rb. Returns (v_R, stop phase, path time)."""
     W.stopped[0] = np.nan
-    return _robot_live(P.scal, P.seg_start, P.seg_move, P.wp, P.parents, P.placements, P.base, P.axes, P.anc,
-                       P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot, W.pos, W.ra, W.rb, t, t_stop)
+    return _robot_live(P.scal, P.seg_start, P.seg_move, P.seg_dwell, P.wp, P.parents, P.placements, P.base,
+                       P.axes, P.jtype, P.anc, P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot, W.pos, W.ra, W.rb,
+                       t, t_stop)
 
 
 # Not inlined: robot_live (the pre-stop table, pictures) and robot_at (the step, after a stop) share one
 # compiled copy. It takes arrays only and allocates nothing (NO_REFCOUNT).
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
-def _robot_live(scal, seg_start, seg_move, wp, parents, placements, base, axes, anc, cap_joint, cap_a, cap_b,
-                q, qd, rot, pos, ra, rb, t, t_stop):
+def _robot_live(scal, seg_start, seg_move, seg_dwell, wp, parents, placements, base, axes, jtype, anc, cap_joint,
+                cap_a, cap_b, q, qd, rot, pos, ra, rb, t, t_stop):
     tau, sigma, phase = path_time(scal, t, t_stop)
-    _joint_trajectory(scal, seg_start, seg_move, wp, tau, sigma, q, qd)
-    _forward_kinematics(parents, placements, base, axes, q, rot, pos)
+    _joint_trajectory(scal, seg_start, seg_move, seg_dwell, wp, tau, sigma, q, qd)
+    _forward_kinematics(parents, placements, base, axes, jtype, q, rot, pos)
     _robot_capsules(cap_joint, cap_a, cap_b, base, rot, pos, ra, rb)
-    return _fastest_joint_speed(anc, axes, qd, rot, pos), phase, tau
+    return _fastest_joint_speed(anc, axes, jtype, qd, rot, pos), phase, tau
 
 
 # The same with SimParams / Work, for callers outside the hot loop (tests, scene, the ISO check).
 @njit(cache=True, error_model="numpy")
 def joint_trajectory(P, tau, sigma, q, qd):
-    _joint_trajectory(P.scal, P.seg_start, P.seg_move, P.wp, tau, sigma, q, qd)
+    _joint_trajectory(P.scal, P.seg_start, P.seg_move, P.seg_dwell, P.wp, tau, sigma, q, qd)
 
 
 @njit(cache=True, error_model="numpy")
 def forward_kinematics(P, q, rot, pos):
-    _forward_kinematics(P.parents, P.placements, P.base, P.axes, q, rot, pos)
+    _forward_kinematics(P.parents, P.placements, P.base, P.axes, P.jtype, q, rot, pos)
 
 
 @njit(cache=True, error_model="numpy")
 def fastest_joint_speed(P, qd, rot, pos):
-    return _fastest_joint_speed(P.anc, P.axes, qd, rot, pos)
+    return _fastest_joint_speed(P.anc, P.axes, P.jtype, qd, rot, pos)
 
 
 @njit(cache=True, error_model="numpy")
@@ -205,8 +236,9 @@ def robot_at(P, k, t_stop, W):
     if stopped[0] == t_stop and t - t_stop >= scal[C_STOP_TIME]:
         tau, _, phase = path_time(scal, t, t_stop)
         return stopped[1], phase, tau
-    v, phase, tau = _robot_live(scal, P.seg_start, P.seg_move, P.wp, P.parents, P.placements, P.base, P.axes,
-                                P.anc, P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot, W.pos, ra, rb, t, t_stop)
+    v, phase, tau = _robot_live(scal, P.seg_start, P.seg_move, P.seg_dwell, P.wp, P.parents, P.placements,
+                                P.base, P.axes, P.jtype, P.anc, P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot,
+                                W.pos, ra, rb, t, t_stop)
     if phase == PHASE_STOPPED:
         stopped[0], stopped[1] = t_stop, v
     else:
