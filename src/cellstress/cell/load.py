@@ -25,7 +25,7 @@ from cellstress.human.body import BODY_RADIUS, WALK_BLOCK_HEIGHT
 from cellstress.robot.model import load_robot, resolve_urdf, unknown_urdf_message
 
 BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap", "all-flaws",
-                                  "s2-deceptive")
+                                  "s2-deceptive", "palletizing", "palletizing-fixed")
 
 
 @dataclass(frozen=True)
@@ -40,6 +40,15 @@ class Cell:
     @property
     def name(self) -> str:
         return self.spec.name
+
+    @property
+    def files_dir(self) -> Path | None:
+        """Where the file's relative paths (a URDF, a trajectory file) are looked up: the cell file's folder, or
+        the built-in cells' folder for a built-in."""
+        if self.directory is not None:
+            return self.directory
+        return Path(str(resources.files("cellstress.cell").joinpath("builtin"))) if self.source in BUILTIN_CELLS \
+            else None
 
 
 def _builtin_path(name: str):
@@ -330,7 +339,7 @@ def check_geometry(cell: Cell) -> None:
     """Checks that need more than one field: the URDF, the robot's program against its joints and their
     position and velocity limits, the robot's cycle time, the start pose and every named start point."""
     spec, src = cell.spec, cell.source
-    urdf = resolve_urdf(spec.robot.urdf, cell.directory)
+    urdf = resolve_urdf(spec.robot.urdf, cell.files_dir)
     if not urdf.is_file():
         raise CellError(src, "robot.urdf", unknown_urdf_message(spec.robot.urdf, urdf))
     try:
@@ -339,7 +348,7 @@ def check_geometry(cell: Cell) -> None:
         raise CellError(src, "robot.urdf", str(exc)) from None
     except Exception as exc:  # pinocchio raises plain RuntimeError/ValueError for unreadable URDFs
         raise CellError(src, "robot.urdf", f"pinocchio cannot read it: {str(exc).splitlines()[0]}") from None
-    robot_program(src, robot, spec.robot, cell.directory)
+    robot_program(src, robot, spec.robot, cell.files_dir)
     caps = spec.robot.capsules if spec.robot.capsules != "auto" else ()
     for i, c in enumerate(tuple(caps) + spec.robot.extra_capsules):
         if c.link not in robot.link_joint:

@@ -28,7 +28,7 @@ def check(
     with spinner_while_compiling(), user_errors():
         c = load_cell(cell)
         spec = c.spec
-        urdf = resolve_urdf(spec.robot.urdf, c.directory)
+        urdf = resolve_urdf(spec.robot.urdf, c.files_dir)
         robot = load_robot(urdf)
         if spec.robot.capsules == "auto":
             caps = list(fitted_capsules(robot))
@@ -41,7 +41,7 @@ def check(
         for i, k in enumerate(spec.robot.extra_capsules):
             caps.append(declared_capsule(robot, f"{k.link}#extra{i}", k.link, k.p0, k.p1, k.radius))
         task = spec.robot.task
-        traj = robot_program(c.source, robot, spec.robot, c.directory)
+        traj = robot_program(c.source, robot, spec.robot, c.files_dir)
         static = check_cell(c)
 
     out = say

@@ -113,7 +113,7 @@ def obstacle_arrays(obstacles) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def build_layout(cell: Cell) -> Layout:
     spec = cell.spec
-    robot = load_robot(resolve_urdf(spec.robot.urdf, cell.directory))
+    robot = load_robot(resolve_urdf(spec.robot.urdf, cell.files_dir))
     if spec.robot.capsules == "auto":
         caps = list(fitted_capsules(robot))
     else:
@@ -121,7 +121,7 @@ def build_layout(cell: Cell) -> Layout:
     for i, c in enumerate(spec.robot.extra_capsules):
         caps.append(declared_capsule(robot, f"{c.link}#extra{i}", c.link, c.p0, c.p1, c.radius))
     task = spec.robot.task
-    traj = robot_program(cell.source, robot, spec.robot, cell.directory)
+    traj = robot_program(cell.source, robot, spec.robot, cell.files_dir)
     anth = spec.human.anthropometry
     body = BodyDimensions(anth.height, anth.upper_arm, anth.forearm, anth.hand, spec.human.walking_speed)
     reach = reach_field(anth.upper_arm, anth.forearm, anth.hand)
