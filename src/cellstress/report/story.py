@@ -9,6 +9,7 @@ import math
 from dataclasses import dataclass
 
 from cellstress.report.episode import EpisodeView
+from cellstress.sim.layout import C_PHASE0
 
 _TURNS = {"walk": "walks forward", "turn-left-45": "turns 45° left", "turn-left-90": "turns 90° left",
           "turn-right-45": "turns 45° right", "turn-right-90": "turns 90° right"}
@@ -82,7 +83,10 @@ def account(view: EpisodeView, episodes: int | None = None) -> Account:
     key = view.key_row
     hit = recs[key]
     x0, y0, h0 = view.start
-    details: list[str] = [f"The worker starts at ({x0:.2f}, {y0:.2f}) m facing {h0:g}°."]
+    phase, cycle = float(view.layout.params.scal[C_PHASE0]), float(view.layout.trajectory.cycle)
+    chosen = "" if view.layout.cell.spec.human.arrival == "fixed" else " (a moment the search chose)"
+    details: list[str] = [f"The worker starts at ({x0:.2f}, {y0:.2f}) m facing {h0:g}°, arriving when the robot is "
+                          f"{phase % cycle:.2f} s into its {cycle:.2f} s cycle{chosen}."]
 
     # what the worker does, action by action, with the distance actually covered (fences and table block)
     for k, act in enumerate(view.actions):
