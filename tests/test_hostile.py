@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import copy
 import json
+import math
 import os
 import subprocess
 import sys
@@ -226,6 +227,19 @@ BAD_CELLS: list[tuple[str, dict, tuple[str, ...]]] = [
     ("ik-pose-far-away", {"cell": _task(tool_frame="tool0", poses=[{"xyz": [0.5, 0.5, 1.0], "rpy_deg": [180, 0, 0]},
                                                                    {"xyz": [50.0, 0, 1], "rpy_deg": [0, 0, 0]}])},
      ("robot.task.poses[1]", "cannot be reached")),
+    ("obstacle-polygon-20000", {"cell": _set("obstacles", [{"name": "x", "height": 1.0, "polygon": [
+        [3.0 + 0.5 * math.cos(2 * math.pi * i / 20_000), 0.5 * math.sin(2 * math.pi * i / 20_000)]
+        for i in range(20_000)]}])}, ("obstacles",)),
+    ("obstacles-5000", {"cell": _set("obstacles", [{"name": f"o{i}", "height": 1.0,
+                                                    "box": {"center": [2.0, 0.0], "size": [0.1, 0.1]}}
+                                                   for i in range(5000)])}, ("obstacles",)),
+    ("obstacle-two-footprints", {"cell": _set("obstacles", [{"name": "x", "height": 1.0, "box": {
+        "center": [2.0, 0.0], "size": [0.1, 0.1]}, "polygon": [[0, 0], [1, 0], [1, 1]]}])},
+     ("obstacles", "exactly one of polygon and box")),
+    ("obstacle-on-start", {"cell": _set("obstacles", [{"name": "crate", "height": 0.5, "box": {
+        "center": [0.7, 3.35], "size": [0.4, 0.4]}}])}, ("human.start", "crate")),
+    ("arrival-backwards", {"cell": _set("human.arrival", {"start": 5.0, "end": 1.0})}, ("human.arrival",)),
+    ("arrival-unknown", {"cell": _set("human.arrival", "sometimes")}, ("human.arrival",)),
     ("python-tag", {"cell_bytes": b"!!python/object/apply:os.system ['touch pwned']\n"}, ("cell.yaml",)),
     ("list-at-top", {"cell_bytes": b"- a\n- b\n"}, ("cell.yaml",)),
 ]
@@ -265,6 +279,8 @@ BAD_RESULTS: list[tuple[str, dict, tuple[str, ...]]] = [
     ("cell-source-missing", {"result": _set("cell.source", "{folder}/in/nothing.yaml")}, ("nothing.yaml",)),
     ("cell-source-etc-passwd", {"result": _set("cell.source", "/etc/passwd")}, ("/etc/passwd",)),
     ("action-unknown", {"result": _set("hazard.actions", ["walk+upright", "fly+upright"])}, ("fly+upright",)),
+    ("phase-not-a-number", {"result": _set("hazard.actions", ["phase:nan", "walk+upright"])}, ("phase:nan",)),
+    ("why-text", {"result": _set("hazard.why", "because")}, ("hazard.why",)),
 ]
 
 FORGED: list[tuple[str, Callable[[dict], None], str]] = [
@@ -278,6 +294,7 @@ FORGED: list[tuple[str, Callable[[dict], None], str]] = [
     ("found", _set("found", False), "found"),
     ("risks", _set("risk_per_episode[0]", 1e-3), "risk_per_episode[0]"),
     ("cell-hash", _set("cell.sha256", "0" * 64), "cell.sha256"),
+    ("why-late", _set("hazard.why.contact_at_s", 0.05), "hazard.why.contact_at_s"),
     ("searcher-unknown", _set("searcher", "<script>alert(1)</script>"), "searcher"),
 ]
 
