@@ -7,7 +7,13 @@ import numpy as np
 from numba import njit
 
 from cellstress.human.body import WALK_BLOCK_HEIGHT
-from cellstress.sim.geometry import capsule_touches_prism, point_segment_2d, polygon_distance, segment_rectangle_xyz
+from cellstress.sim.geometry import (
+    NO_REFCOUNT,
+    capsule_touches_prism,
+    point_segment_2d,
+    polygon_distance,
+    segment_rectangle_xyz,
+)
 from cellstress.sim.layout import B_HEAD_RISE, B_R_HEAD, B_R_TRUNK, B_SHOULDER_HALF, DEV_SCANNER, N_BODY_CAPSULES
 
 
@@ -77,6 +83,25 @@ def trunk_clear(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr):
     hanging arms are not held off obstacles: bent over a table they would hit its top, which the model's fixed
     arm pose cannot avoid (the articulated worker can); the reach volumes ignore obstacles likewise.
     """
+    if obs_poly.shape[0] and not obstacles_clear(obs_verts, obs_poly, obs_box, ha, hb, hr):
+        return False
+    extent = body[B_HEAD_RISE] + body[B_R_HEAD] + body[B_SHOULDER_HALF]
+    for f in range(fences.shape[0]):
+        x0, y0, x1, y1, zlo, zhi = fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3], fences[f, 4], fences[f, 5]
+        if point_segment_2d(ha[2, 0], ha[2, 1], x0, y0, x1, y1) > extent:
+            continue
+        for c in (2, 3, 4, 5):
+            if segment_rectangle_xyz(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2],
+                                     x0, y0, x1, y1, zlo, zhi)[0] < hr[c]:
+                return False
+    return True
+
+
+# Not inlined: move_worker is inlined into step_action and worker_paths, and one shared compiled copy of this
+# loop costs a cold compile less than two inlined ones (it runs once per time step either way).
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def obstacles_clear(obs_verts, obs_poly, obs_box, ha, hb, hr):
+    """The trunk and head capsules (2, 3) keep out of every obstacle's prism."""
     for o in range(obs_poly.shape[0]):
         h = obs_box[o, 4]
         for c in (2, 3):
@@ -88,14 +113,5 @@ def trunk_clear(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr):
                 continue
             if capsule_touches_prism(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2], r, obs_verts,
                                      obs_poly[o, 0], obs_poly[o, 1], h):
-                return False
-    extent = body[B_HEAD_RISE] + body[B_R_HEAD] + body[B_SHOULDER_HALF]
-    for f in range(fences.shape[0]):
-        x0, y0, x1, y1, zlo, zhi = fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3], fences[f, 4], fences[f, 5]
-        if point_segment_2d(ha[2, 0], ha[2, 1], x0, y0, x1, y1) > extent:
-            continue
-        for c in (2, 3, 4, 5):
-            if segment_rectangle_xyz(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2],
-                                     x0, y0, x1, y1, zlo, zhi)[0] < hr[c]:
                 return False
     return True
