@@ -11,7 +11,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from pydantic import ValidationError
+
 from cellstress.cell.load import Cell
+from cellstress.core.errors import CellstressError
 from cellstress.core.version import __version__
 from cellstress.human.actions import ACTION_NAMES, N_ACTIONS
 from cellstress.searchers.distinct import hazard_class, hazard_class_record, root_cause
@@ -35,6 +38,10 @@ from cellstress.verify.tree import QUANT_ANGLE, QUANT_XY, decide
 from cellstress.verify.witness import write_witness
 
 WITNESS_DIR = "witness-{:02d}"
+
+
+class VerifyError(CellstressError):
+    """A bad option of a verification (a user error: exit code 2)."""
 
 
 @dataclass(frozen=True)
@@ -192,3 +199,22 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
         result.write(out)
     return result
 
+
+
+def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "all", time_limit: float | None = None,
+                bounds: tuple[str, ...] | None = None, workers: int = 1, out: str | Path | None = None,
+                progress: Callable[[int, int], None] | None = None) -> VerifyResult:
+    """``run_verify`` with its options checked: VerifyError (a user error) for a bad one."""
+    fields: dict[str, Any] = {"horizon": sim.actions_per_episode if horizon is None else horizon, "phases": phases}
+    if time_limit is not None:
+        fields["time_limit"] = time_limit
+    if bounds is not None:
+        fields["bounds"] = tuple(bounds)
+    try:
+        options = VerifyOptions.model_validate(fields, strict=False)
+    except ValidationError as exc:
+        e = exc.errors(include_url=False)[0]
+        raise VerifyError(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}") from None
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise VerifyError(f"workers must be a whole number >= 1, not {workers!r}")
+    return run_verify(sim, options, workers=workers, out=out, progress=progress)

@@ -1,0 +1,95 @@
+"""The report of a verification: the hazard map (``verify.png``: arrival phases x start points) and the text
+summary ``cellstress verify`` prints."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.colors import ListedColormap, LogNorm
+
+from cellstress.report import draw as D
+from cellstress.verify.records import PROVED_SAFE, UNDECIDED, UNSAFE, VerifyResult
+
+PNG_NAME = "verify.png"
+MAP_SIZE = D.FigureSize(9.0, 3.6, 100)
+SAFE_COLOUR = "#d9f0d3"
+UNDECIDED_COLOUR = "#bdbdbd"
+
+
+@D.plain_text
+def hazard_map(res: VerifyResult, path: str | Path, size: D.FigureSize = MAP_SIZE) -> Path:
+    """One row per start point, one column per arrival phase: the exact probability that a uniformly random
+    worker reaches the unsafe set (log colour scale), proved-safe sub-trees green, undecided ones grey."""
+    starts = list(dict.fromkeys(s.start for s in res.subtrees))
+    phases = sorted({s.phase for s in res.subtrees})
+    grid = np.full((len(starts), len(phases)), np.nan)
+    status = np.zeros(grid.shape, dtype=int)  # 0 safe, 1 unsafe, 2 undecided
+    for s in res.subtrees:
+        i, j = starts.index(s.start), phases.index(s.phase)
+        grid[i, j] = s.probability if s.hazardous else np.nan
+        status[i, j] = 1 if s.verdict == UNSAFE else 2 if s.verdict == UNDECIDED else 0
+    fig = D.new_figure(size)
+    ax = fig.add_axes((0.14, 0.28, 0.74, 0.56))
+    extent = (-0.5, len(phases) - 0.5, len(starts) - 0.5, -0.5)
+    ax.imshow(np.where(status == 2, 1.0, 0.0), cmap=ListedColormap([SAFE_COLOUR, UNDECIDED_COLOUR]), vmin=0, vmax=1,
+              aspect="auto", extent=extent, interpolation="nearest")
+    if np.isfinite(grid).any():
+        lo = float(np.nanmin(grid))
+        img = ax.imshow(grid, cmap="Reds", norm=LogNorm(vmin=min(lo, 0.99e-1), vmax=1.0), aspect="auto",
+                        extent=extent, interpolation="nearest")
+        bar = fig.colorbar(img, cax=fig.add_axes((0.9, 0.28, 0.02, 0.56)))
+        bar.set_label("P(hazard), uniform worker", fontsize=8)
+    ax.set_yticks(range(len(starts)), starts, fontsize=8)
+    step = max(1, len(phases) // 12)
+    ax.set_xticks(range(0, len(phases), step), [f"{phases[k]:g}" for k in range(0, len(phases), step)], fontsize=8)
+    ax.set_xlabel("arrival phase: the robot's time in its cycle when the worker arrives [s]", fontsize=8)
+    ax.set_title(f"{res.cell.name}: {res.verdict}, {res.options.horizon} actions per episode "
+                 f"(green: proved safe; grey: undecided)", fontsize=10, loc="left")
+    fig.text(0.02, 0.03, f"{res.hazardous:,} of {res.sequences:,} sequences hazardous"
+             + (f"; {res.undecided:,} undecided" if res.undecided else ""), fontsize=8, color="#444444")
+    return D.save_png(fig, path)
+
+
+def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None) -> list[str]:
+    """What ``cellstress verify`` prints: the scope, the proof's size, what each bound cut, the verdict, the
+    hazardous sub-trees and each hazard class with its witness."""
+    o = res.options
+    n_starts = len({s.start for s in res.subtrees})
+    lines = [
+        f"cell      {res.cell.name}  horizon {o.horizon} actions  phases {o.phases} ({len(res.subtrees)} sub-trees: "
+        f"{n_starts} start point{'s' if n_starts != 1 else ''} x arrival phases)",
+        f"criterion {criterion_text}",
+        f"decided   {res.sequences - res.undecided:,} of {res.sequences:,} action sequences; {res.states:,} distinct "
+        f"states visited",
+    ]
+    for p in res.pruned:
+        lines.append(f"pruned    {p.bound}: {p.states:,} states, {p.sequences:,} sequences proved safe")
+    scope = (f"within this worker model (30 actions, {o.horizon} per episode), {res.dt:g} s steps, positions merged "
+             f"within {res.merge_xy * 1e6:g} um and angles within {res.merge_angle:g} rad, and this criterion")
+    if res.verdict == PROVED_SAFE:
+        lines.append(f"PROVED-SAFE: no sequence reaches the unsafe set from any start point at any arrival phase "
+                     f"decided ({scope})")
+    elif res.verdict == UNDECIDED:
+        lines.append(f"UNDECIDED: {res.undecided:,} sequences were not decided (time limit); no hazard among the "
+                     f"rest; this is not a proof")
+    else:
+        lines.append(f"UNSAFE: {res.hazardous:,} of {res.sequences:,} sequences hazardous "
+                     f"(p = {res.hazardous / res.sequences:.3e} for a uniformly random worker)")
+    for s in res.subtrees:
+        if s.hazardous:
+            lines.append(f"  {s.start} at phase {s.phase:g} s: {s.hazardous:,} of {s.sequences:,} hazardous "
+                         f"(p = {s.probability:.3e})")
+    undecided = [s for s in res.subtrees if s.undecided]
+    for s in undecided:
+        lines.append(f"  undecided: {s.start} at phase {s.phase:g} s ({s.undecided:,} sequences)")
+    for i, w in enumerate(res.classes, start=1):
+        k = w.klass
+        failed = "no device saw the worker" if k.device == "none" else f"{k.device} stopped the robot too late"
+        where = f"{out}/{w.file}" if out else w.file
+        x0, y0, x1, y1 = k.approach_cell
+        lines.append(f"class {i:<3} {failed}; {k.robot_link} / {k.body_region}, worker at x {x0:g}..{x1:g}, "
+                     f"y {y0:g}..{y1:g}; {w.sequences:,} sequences; first at "
+                     f"{w.start}, phase {w.phase:g} s: {', '.join(w.actions) or '(no action: unsafe at the start)'}")
+        lines.append(f"          cellstress replay {where}")
+    return lines
