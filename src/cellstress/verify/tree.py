@@ -68,6 +68,7 @@ class TreeOutcome:
     pruned_sequences: dict[str, int] = field(default_factory=dict)
     hits: list[Hit] = field(default_factory=list)
     timed_out: bool = False
+    layers: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)  # (sorted keys, states), if kept
 
     @property
     def undecided(self) -> int:
@@ -110,10 +111,10 @@ class _Judge:
 
 
 def decide(sim, horizon: int, bounds: Bounds, *, deadline: float | None = None,
-           progress: Callable[[int], None] | None = None) -> TreeOutcome:
+           progress: Callable[[int], None] | None = None, keep: bool = False) -> TreeOutcome:
     """Decide every sequence of ``horizon`` actions from ``sim``'s start (see the module). ``deadline``: a
     ``time.monotonic()`` after which the tree is left undecided; ``progress(sequences)`` is told how many more
-    sequences each step decided."""
+    sequences each step decided; ``keep``: keep every layer's merged states, for ``lookup``."""
     n_act = N_ACTIONS
     out = TreeOutcome(horizon, n_act ** horizon)
     judge = _Judge(sim)
@@ -173,9 +174,38 @@ def decide(sim, horizon: int, bounds: Bounds, *, deadline: float | None = None,
         states, mult, prefixes = _merge(np.concatenate(kept_states), np.concatenate(kept_mult),
                                         np.concatenate(kept_parent), np.concatenate(kept_action), prefixes)
         out.states.append(len(states))
+        if keep:
+            keys = merge_keys(states)
+            order = np.argsort(keys)
+            out.layers.append((keys[order], states[order]))
         if not len(states):
             break
     return out
+
+
+def lookup(sim, out: TreeOutcome, bounds: Bounds, actions) -> str:
+    """How a kept tree (``decide(..., keep=True)``) counted the sequence ``actions``: ``hazardous``, ``safe`` or
+    ``pruned:BOUND``. It follows the sequence through the merged states, as the counting did: the state after
+    each action is the merged state its key falls on."""
+    state = sim.reset()
+    if state[L.S_UNSAFE] != 0.0:
+        return "hazardous"
+    for depth, a in enumerate(actions, start=1):
+        child, rows = sim.step(state, int(a))
+        if child[L.S_UNSAFE] != 0.0:
+            return "hazardous"
+        if depth == out.horizon:
+            return "safe"
+        alive = np.ones(1, dtype=bool)
+        for name, cut in bounds.prune(child[None, :], rows[-1:], alive, out.horizon - depth):
+            if cut[0]:
+                return f"pruned:{name}"
+        keys, states = out.layers[depth - 1]
+        i = int(np.searchsorted(keys, merge_keys(child[None, :])[0]))
+        if i >= len(keys) or keys[i] != merge_keys(child[None, :])[0]:
+            raise KeyError(f"the state after {list(actions[:depth])} is in no merged state of layer {depth}")
+        state = states[i]
+    return "safe"
 
 
 def _merge(children, cmult, parent, action, prefixes):
