@@ -27,8 +27,8 @@ from cellstress.searchers import DEFAULT_BUDGET, DEFAULT_TOP_K
 from cellstress.searchers import search as _search
 from cellstress.searchers.result import SearchResult
 from cellstress.sim.simulator import Simulator, Trace
-from cellstress.verify.records import VerifyResult
-from cellstress.verify.run import verify_cell
+from cellstress.verifier.records import VerifyResult
+from cellstress.verifier.run import verify_cell
 
 CellLike = Cell | str | Path
 

@@ -23,8 +23,8 @@ from cellstress.searchers import distinct_record, hazard_record, search
 from cellstress.searchers.common import SearchError
 from cellstress.searchers.result import DistinctHazard, Hazard, SearchResult
 from cellstress.sim.simulator import Simulator, Trace
-from cellstress.verify.witness import SEARCHER as WITNESS_SEARCHER
-from cellstress.verify.witness import witness_result
+from cellstress.verifier.witness import SEARCHER as WITNESS_SEARCHER
+from cellstress.verifier.witness import witness_result
 
 MAX_LISTED_DIFFERENCES = 4
 

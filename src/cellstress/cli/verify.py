@@ -46,7 +46,7 @@ def verify(
     from cellstress.report.scope import judged_by
     from cellstress.report.verify import PNG_NAME, hazard_map, summary_lines
     from cellstress.sim.simulator import Simulator
-    from cellstress.verify.run import verify_cell
+    from cellstress.verifier.run import verify_cell
 
     with user_errors():
         check_criterion(criterion)

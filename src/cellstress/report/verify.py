@@ -9,7 +9,7 @@ import numpy as np
 from matplotlib.colors import ListedColormap, LogNorm
 
 from cellstress.report import draw as D
-from cellstress.verify.records import PROVED_SAFE, UNDECIDED, UNSAFE, VerifyResult
+from cellstress.verifier.records import PROVED_SAFE, UNDECIDED, UNSAFE, VerifyResult
 
 PNG_NAME = "verify.png"
 MAP_SIZE = D.FigureSize(9.0, 3.6, 100)

@@ -25,7 +25,7 @@ Count = Annotated[int, Field(ge=0)]
 
 class VerifyOptions(Record):
     """What to decide: episodes of ``horizon`` actions, at the arrival phases ``phases`` selects
-    (``verify.phases``), with the pruning ``bounds`` named; ``time_limit`` [s] (None: none)."""
+    (``verifier.phases``), with the pruning ``bounds`` named; ``time_limit`` [s] (None: none)."""
 
     horizon: Annotated[int, Field(ge=1, le=12)] = 8
     phases: Literal["all", "cell"] = "all"

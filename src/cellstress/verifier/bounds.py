@@ -7,7 +7,7 @@ soundness argument; ``tests/verify/test_bounds.py`` checks the assumptions they 
 * ``at-rest``: a latched stop has taken full effect: the robot stands for good, and the criterion's kernel test
   needs it to move.
 * ``distance``: the worker cannot come within the criterion's contact distance of anything the robot can occupy
-  in the time left (``verify.reach``).
+  in the time left (``verifier.reach``).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from cellstress.sim import layout as L
-from cellstress.verify.reach import SweptField
+from cellstress.verifier.reach import SweptField
 
 AT_REST = "at-rest"
 DISTANCE = "distance"

@@ -4,6 +4,7 @@ does not depend on the number of workers or on which finished first."""
 
 from __future__ import annotations
 
+import multiprocessing
 import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
@@ -21,9 +22,9 @@ from cellstress.searchers.distinct import hazard_class, hazard_class_record, roo
 from cellstress.searchers.result import CellRef
 from cellstress.sim.layout import M_STEP, M_T
 from cellstress.sim.simulator import Simulator
-from cellstress.verify.bounds import Bounds
-from cellstress.verify.phases import StartPoint, arrival_phases, start_points
-from cellstress.verify.records import (
+from cellstress.verifier.bounds import Bounds
+from cellstress.verifier.phases import StartPoint, arrival_phases, start_points
+from cellstress.verifier.records import (
     PROVED_SAFE,
     UNDECIDED,
     UNSAFE,
@@ -34,8 +35,8 @@ from cellstress.verify.records import (
     VerifyResult,
     Witness,
 )
-from cellstress.verify.tree import QUANT_ANGLE, QUANT_XY, decide
-from cellstress.verify.witness import write_witness
+from cellstress.verifier.tree import QUANT_ANGLE, QUANT_XY, decide
+from cellstress.verifier.witness import write_witness
 
 WITNESS_DIR = "witness-{:02d}"
 
@@ -87,9 +88,13 @@ def _simulator(cell: Cell) -> Simulator:
 
 def decide_task(task: Task, progress: Callable[[int], None] | None = None) -> Decided:
     """Decide one sub-tree (runs in a worker process)."""
-    base = _simulator(task.cell)
-    sim = base.with_start(task.start.pose, task.phase)
     opts = task.options
+    if task.deadline is not None and time.time() > task.deadline:  # not begun: all of it undecided
+        total = N_ACTIONS ** opts.horizon
+        return Decided(Subtree(start=task.start.name, phase=task.phase, verdict=UNDECIDED, sequences=total,
+                               hazardous=0, undecided=total, probability=0.0, states=(), expanded=0, pruned=(),
+                               classes=()), ())
+    sim = _simulator(task.cell).with_start(task.start.pose, task.phase)
     deadline = None if task.deadline is None else time.monotonic() + (task.deadline - time.time())
     out = decide(sim, opts.horizon, Bounds(sim, opts.bounds, opts.horizon), deadline=deadline, progress=progress)
     found: dict[tuple, list] = {}
@@ -143,7 +148,9 @@ def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out:
     if workers <= 1 or len(tasks) == 1:
         decided = [decide_task(t, tick) for t in tasks]
     else:
-        with ProcessPoolExecutor(max_workers=workers, initializer=_init_worker) as pool:
+        # spawned, not forked: numba's thread pool in this process makes a fork unsafe
+        with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                                 initializer=_init_worker) as pool:
             futures = [pool.submit(decide_task, t) for t in tasks]
             for f in futures:
                 f.add_done_callback(lambda f: tick(f.result().subtree.sequences) if not f.exception() else None)

@@ -21,7 +21,7 @@ from cellstress.human.actions import ACTION_NAMES
 from cellstress.robot.model import BUILTIN_URDFS
 from cellstress.searchers import hazard_record
 from cellstress.searchers.result import FORMAT, CellRef, EpisodeRef, SearchResult, TopEpisode
-from cellstress.verify.phases import StartPoint
+from cellstress.verifier.phases import StartPoint
 
 SEARCHER = "verify"  # the ``searcher`` of a witness's result file
 CELL_FILE = "cell.yaml"

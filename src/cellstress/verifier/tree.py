@@ -18,7 +18,7 @@ class (``searchers.distinct``): merging it away could hide a class. The merged s
 state, bit for bit, so every witness is a sequence the simulator really plays.
 
 **Counting.** A child that is unsafe ends its episode: all 30^r completions of its prefix are hazardous
-(r actions left), times its parent's multiplicity. A child proved safe by a bound (``verify.bounds``) counts its
+(r actions left), times its parent's multiplicity. A child proved safe by a bound (``verifier.bounds``) counts its
 completions as safe. A leaf that is neither is safe. Every count is a Python int; hazardous + safe = 30^N
 exactly when the tree is decided, and what a time limit leaves is reported as undecided.
 """
@@ -35,7 +35,7 @@ import numpy as np
 from cellstress.human.actions import N_ACTIONS
 from cellstress.sim import layout as L
 from cellstress.sim.kernels.expand import expand_states
-from cellstress.verify.bounds import Bounds
+from cellstress.verifier.bounds import Bounds
 
 QUANT_XY = 1e-6  # m: positions this close merge
 QUANT_ANGLE = 1e-9  # rad: headings and flexions this close merge
@@ -191,7 +191,7 @@ def lookup(sim, out: TreeOutcome, bounds: Bounds, actions) -> str:
     if state[L.S_UNSAFE] != 0.0:
         return "hazardous"
     for depth, a in enumerate(actions, start=1):
-        child, rows = sim.step(state, int(a))
+        child, rows = sim.step(state, a)
         if child[L.S_UNSAFE] != 0.0:
             return "hazardous"
         if depth == out.horizon:
