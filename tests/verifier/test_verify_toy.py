@@ -2,14 +2,19 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 
+import numpy as np
 import pytest
 
 import cellstress
-from cellstress.cell.load import builtin_text
+from cellstress.cell.load import builtin_text, load_cell, with_criterion
 from cellstress.cli import main
 from cellstress.searchers.result import SearchResult
+from cellstress.sim.simulator import Simulator
+from cellstress.verifier.bounds import Bounds
+from cellstress.verifier.tree import decide
 
 
 def _cell_file(tmp_path, name: str, start: str, phase: float):
@@ -41,6 +46,16 @@ def test_worker_touching_the_moving_robot_at_the_start(tmp_path) -> None:
     assert res.verdict == "UNSAFE" and res.hazardous == 30 ** 3 and res.subtrees[0].probability == 1.0
     assert len(res.classes) == 1 and res.classes[0].actions == ()
     assert SearchResult.load(tmp_path / "out" / res.classes[0].file).found
+
+
+def test_criterion_that_judges_contacts_against_brute_force(tmp_path) -> None:
+    # ISO/TS 15066 judges each contact in Python (no kernel test): the verifier steps those children again
+    path = _cell_file(tmp_path, "touch", "{xy: [-1.25, -0.2], heading_deg: 0.0}", 0.75)
+    sim = Simulator(with_criterion(load_cell(path), "iso15066"))
+    out = decide(sim, 2, Bounds(sim, horizon=2))
+    brute = sim.run_batch(np.array(list(itertools.product(range(30), repeat=2))))
+    assert out.hazardous == int(brute.unsafe.sum())
+    assert np.count_nonzero(brute.min_d <= 0.0) > 100  # many contacts were judged (here: all below the limits)
 
 
 def test_command_exit_codes_and_replayable_witnesses(tmp_path, capsys) -> None:

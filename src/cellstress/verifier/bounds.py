@@ -37,7 +37,10 @@ class Bounds:
         # never unsafe when VTOL >= 0. A criterion that judges contacts itself (VTOL inf: no kernel test) may call
         # a contact with a standing robot unsafe (ISO/TS 15066 clamping), so the bound does not apply to it.
         self.at_rest = AT_REST in enabled and sim.contacts is None and 0.0 <= vtol < np.inf
-        self.swept = SweptField(sim, horizon) if DISTANCE in enabled and sim.contacts is None else None
+        # Every criterion judges contacts only (d_HR at most its distance tolerance, the kernel's DTOL; a criterion
+        # without a kernel test is shown only the rows within it, Simulator.first_unsafe): the distance bound holds
+        # for all of them.
+        self.swept = SweptField(sim, horizon) if DISTANCE in enabled else None
 
     def prune(self, children: np.ndarray, last: np.ndarray, alive: np.ndarray, left: int
               ) -> Iterator[tuple[str, np.ndarray]]:
