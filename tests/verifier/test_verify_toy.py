@@ -67,7 +67,13 @@ def test_command_exit_codes_and_replayable_witnesses(tmp_path, capsys) -> None:
     assert main(["replay", str(witness)]) == 0
     assert "REPRODUCED bit-exactly" in capsys.readouterr().out
     assert main(["verify", "baseline", "--phases", "cell", "--horizon", "3", "--out", str(tmp_path / "b")]) == 0
-    assert main(["verify", "baseline", "--horizon", "13", "--out", str(tmp_path / "c")]) == 2
+    capsys.readouterr()
+    for bad in (["--horizon", "13"], ["--horizon", "0"], ["--phases", "some"], ["--workers", "0"],
+                ["--time-limit", "-1"], ["--criterion", "nope"]):
+        assert main(["verify", "baseline", *bad, "--out", str(tmp_path / "c")]) == 2, bad
+        err = capsys.readouterr().err
+        assert err.startswith("error: ") and err.count("\n") == 1, (bad, err)
+    assert main(["verify", str(tmp_path / "no-such-cell.yaml"), "--out", str(tmp_path / "c")]) == 2
 
 
 def test_time_limit_leaves_subtrees_undecided(tmp_path) -> None:
