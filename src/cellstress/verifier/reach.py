@@ -8,19 +8,21 @@ only when the worker walks, by one stride (walking speed x dt) per step at most;
 it.
 
 **The robot.** Before its stop takes effect the robot's path time is tau0 + t; braking only slows it down
-(``kernels.robot.path_time``). So from step k to the end of the episode, whatever the devices do, the robot's
-pose is its path's pose at some path time in [tau0 + k dt, tau0 + t_end]. The path is sampled every ``dt /
-SUB`` of path time; between samples no point of a capsule axis moves more than ``speed`` x half the spacing,
-where ``speed`` bounds every capsule point's speed along the path: the sum over the joints that move it of the
-joint's peak speed (a minimum-jerk segment peaks at 1.875 times its mean speed) times the point's distance from
-the joint's origin (at most the lengths of the links in between plus the capsule's end).
+(``kernels.robot.path_time``), and a stop latched later takes effect later. So at a step k' after step k,
+whatever the devices do, the robot's pose is its path's pose at some path time in [tau0 + k dt, tau0 + k' dt].
+The path is sampled every ``dt / SUB`` of path time; between samples no point of a capsule axis moves more than
+``speed`` x half the spacing, where ``speed`` bounds every capsule point's speed along the path: the sum over the
+joints that move it of the joint's peak speed (a minimum-jerk segment peaks at 1.875 times its mean speed) times
+the point's distance from the joint's origin (at most the lengths of the links in between plus the capsule's
+end).
 
-**The field.** For each layer, ``dist`` on a grid of floor points (spacing ``GRID``, at hip height) is the least
-distance to any robot capsule sample in that layer's window, less the sampling allowance; the true distance from
-any H is at least the nearest node's value less half a grid diagonal.
+**The field.** For each robot sample, the distance from every node of a floor grid (spacing ``GRID``, at hip
+height) to the sample's capsules, less the sampling allowance and half a grid diagonal: the true distance from
+any H to that sample's neighbourhood is at least its nearest node's value.
 
-A state whose stop has not taken effect, with s steps left, is safe when that lower bound, less the worker's
-radius and s strides, exceeds the criterion's contact distance.
+A state at step k whose stop has not taken effect is safe when, for every later step k' of the episode, the
+least of those values over the samples of path times [tau0 + k dt, tau0 + k' dt] at its pivot's node, less
+(k' - k) strides and the worker's radius, exceeds the criterion's contact distance.
 """
 
 from __future__ import annotations
@@ -97,29 +99,54 @@ class SweptField:
         self.x0, self.y0 = float(fl[0]), float(fl[2])
         nx = int(np.ceil((fl[1] - fl[0]) / GRID)) + 1
         ny = int(np.ceil((fl[3] - fl[2]) / GRID)) + 1
-        per_sample = np.empty((n, nx, ny))
-        _sample_field(ra, rb, P.cap_r, self.x0, self.y0, GRID, self.hip, per_sample)
-        # layer l's window: samples from step l * spa on (one sample earlier, for rounding), to the end
-        suffix = np.minimum.accumulate(per_sample[::-1], axis=0)[::-1]
-        self.layers = np.stack([suffix[max(0, layer * self.spa * SUB - 1)] for layer in range(horizon + 1)])
-        self.layers -= self.allowance + GRID * np.sqrt(0.5)
+        self.samples = np.empty((n, nx, ny))
+        _sample_field(ra, rb, P.cap_r, self.x0, self.y0, GRID, self.hip, self.samples)
+        self.samples -= self.allowance + GRID * np.sqrt(0.5)
 
-    def lower_bound(self, layer: int, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """A lower bound on the distance from hip pivots (x, y) to the robot from layer ``layer`` on."""
-        f = self.layers[layer]
-        ix = np.clip(np.rint((x - self.x0) / GRID).astype(np.int64), 0, f.shape[0] - 1)
-        iy = np.clip(np.rint((y - self.y0) / GRID).astype(np.int64), 0, f.shape[1] - 1)
-        return f[ix, iy]
+    def lower_bound(self, step: int, steps_left: int, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """A lower bound, over the next ``steps_left`` steps after step ``step``, on the distance from the hip
+        pivot (started at (x, y), walking a stride a step) to the robot: for each later step k, the least
+        distance to the samples of path times [tau0 + step dt, tau0 + k dt] (one more sample each side, for
+        rounding), less the strides walked by step k."""
+        out = np.empty(len(x))
+        _window_bound(self.samples, self.x0, self.y0, GRID, SUB, int(step), int(steps_left), self.stride,
+                      np.ascontiguousarray(x), np.ascontiguousarray(y), out)
+        return out
 
     def safe(self, children: np.ndarray, steps_left: int) -> np.ndarray:
-        """Children (all after the same number of actions) that no completion of ``steps_left`` steps brings
-        within the contact distance; only those whose stop has not taken effect (the window assumes it)."""
+        """Children (all at the same step) that no completion of ``steps_left`` steps brings within the contact
+        distance; only those whose stop has not taken effect (the window assumes it)."""
         if not len(children):
             return np.zeros(0, dtype=bool)
-        layer = int(children[0, L.S_ACTIONS])
+        step = int(children[0, L.S_K])
         t = children[:, L.S_K] * self.dt
-        d = self.lower_bound(layer, children[:, L.S_X], children[:, L.S_Y])
-        return (t < children[:, L.S_TSTOP]) & (d - self.radius - steps_left * self.stride > self.dtol)
+        d = self.lower_bound(step, steps_left, children[:, L.S_X], children[:, L.S_Y])
+        return (t < children[:, L.S_TSTOP]) & (d - self.radius > self.dtol)
+
+
+@njit(cache=True)
+def _window_bound(samples, x0, y0, g, sub, step, steps_left, stride, xs, ys, out):
+    """``SweptField.lower_bound``: out[c] = min over k in step+1..step+steps_left of (least sample value at the
+    hip pivot's grid node over samples (step * sub - 1) .. (k * sub + 1)) - (k - step) * stride."""
+    nx, ny, n = samples.shape[1], samples.shape[2], samples.shape[0]
+    lo = max(0, step * sub - 1)
+    for c in range(xs.shape[0]):
+        ix = min(max(int(np.rint((xs[c] - x0) / g)), 0), nx - 1)
+        iy = min(max(int(np.rint((ys[c] - y0) / g)), 0), ny - 1)
+        best = np.inf
+        run = np.inf
+        i = lo
+        for k in range(step + 1, step + steps_left + 1):
+            hi = min(k * sub + 1, n - 1)
+            while i <= hi:
+                v = samples[i, ix, iy]
+                if v < run:
+                    run = v
+                i += 1
+            b = run - (k - step) * stride
+            if b < best:
+                best = b
+        out[c] = best
 
 
 @njit(cache=True, parallel=True)
