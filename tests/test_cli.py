@@ -110,7 +110,8 @@ def test_check_baseline_summary(capsys, baseline) -> None:
     assert "ur10" in out and "6 joints" in out
     assert re.search(r"^capsules\s+\d+", out, re.M) and "forearm_link" in out
     assert re.search(r"cycle time \d+\.\d+ s", out)
-    assert re.search(rf"^table\s+{len(baseline['table']['polygons'])} polygon", out, re.M)
+    assert re.search(r"^obstacles\s+2$", out, re.M)  # the table and the robot's pedestal
+    assert re.search(r"^\s+table\s+height 0.85 m, footprint of 8 corners$", out, re.M)
     assert re.search(rf"^fences\s+{len(baseline['fences'])}\b", out, re.M)
     assert re.search(rf"^devices\s+{len(baseline['devices'])}\b", out, re.M)
     for d in baseline["devices"]:

@@ -28,7 +28,7 @@ def _unseen_and_clear(P, W):
     for d in range(P.dev_kind.shape[0]):
         if K.device_sees(P.dev_kind, P.dev_rect, P.dev_poly, P.dev_verts, P.body, d, W.ha, W.hb, W.hr):
             return False
-    return K.trunk_clear(P.body, P.fences, W.ha, W.hb, W.hr)
+    return K.trunk_clear(P.body, P.fences, P.obs_verts, P.obs_poly, P.obs_box, W.ha, W.hb, W.hr)
 
 
 @njit(cache=True)

@@ -376,9 +376,12 @@ def _check_standing_point(cell: Cell, where: str, xy) -> None:
     if not (fl.xmin + r <= x <= fl.xmax - r and fl.ymin + r <= y <= fl.ymax - r):
         raise CellError(src, where, f"({x}, {y}) is not on the floor x {fl.xmin}..{fl.xmax}, "
                                     f"y {fl.ymin}..{fl.ymax} (keeping the body's {r} m radius inside)")
-    for i, poly in enumerate(spec.table.polygons):
-        if polygon_distance(x, y, poly) < r:
-            raise CellError(src, where, f"({x}, {y}) is inside or touching the table (table.polygons[{i}])")
+    n_table = 0 if spec.table is None else len(spec.table.polygons)
+    for i, ob in enumerate(spec.solid_obstacles()):
+        if polygon_distance(x, y, ob.footprint()) < r:
+            field = f"table.polygons[{i}]" if i < n_table else f"obstacles[{i - n_table}]"
+            raise CellError(src, where, f"({x}, {y}) is inside or touching {ob.name!r} ({field}), keeping the "
+                                        f"body's {r} m radius clear")
     for i, fence in enumerate(spec.fences):
         for a, b in zip(fence.points, fence.points[1:], strict=False):
             if fence.bottom < WALK_BLOCK_HEIGHT and point_segment_distance(x, y, a, b) < r:

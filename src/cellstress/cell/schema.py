@@ -29,6 +29,7 @@ from cellstress.core.fields import (
     Coordinate,
     Elevation,
     Height,
+    Length,
     Name,
     Point2,
     Point3,
@@ -122,6 +123,9 @@ class RobotSpec(Record):
     """Capsules added to the robot's own, e.g. a gripper holding a part."""
     stopping_time: PositiveTime = 0.15
     """Time [s] from the stop signal to standstill, braking along the path."""
+    pedestal: Literal["auto", "none"] = "auto"
+    """auto: the robot's base (its base link's collision mesh in plan, from the floor up to the base link's top)
+    is an obstacle the worker cannot walk or lean into; none: nothing below the base (a robot hung from above)."""
     task: TaskSpec
     """The robot's cyclic program."""
 
@@ -133,6 +137,47 @@ class TableSpec(Record):
     """Height of the table top [m]."""
     polygons: tuple[Polygon, ...] = Field(min_length=1, max_length=MAX_COUNT)
     """Outlines of the table top [m], each a simple polygon of at most 256 points."""
+
+
+class BoxFootprint(Record):
+    """A rectangle on the floor."""
+
+    center: Point2
+    """Centre [m]."""
+    size: tuple[Length, Length]
+    """Length along its own x axis and width [m]."""
+    yaw_deg: Angle = 0.0
+    """Rotation about the vertical axis [deg], counter-clockwise seen from above."""
+
+    def corners(self) -> tuple[Point2, ...]:
+        c, s = math.cos(math.radians(self.yaw_deg)), math.sin(math.radians(self.yaw_deg))
+        hx, hy = self.size[0] / 2.0, self.size[1] / 2.0
+        return tuple((self.center[0] + c * u - s * v, self.center[1] + s * u + c * v)
+                     for u, v in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)))
+
+
+class ObstacleSpec(Record):
+    """A static solid standing on the floor (a conveyor, a pallet, a machine, a pedestal): a footprint raised to
+    a height. The worker cannot walk into it and cannot lean the trunk or head into it."""
+
+    name: Name
+    """Its name in outputs and pictures."""
+    polygon: Polygon | None = None
+    """Its footprint [m], a simple polygon; give this or ``box``."""
+    box: BoxFootprint | None = None
+    """Its footprint as a rectangle; give this or ``polygon``."""
+    height: Height
+    """Height of its top above the floor [m]."""
+
+    @model_validator(mode="after")
+    def _one_footprint(self) -> ObstacleSpec:
+        if (self.polygon is None) == (self.box is None):
+            raise ValueError("give exactly one of polygon and box")
+        return self
+
+    def footprint(self) -> tuple[Point2, ...]:
+        """The footprint's corners [m]."""
+        return self.polygon if self.polygon is not None else self.box.corners()
 
 
 class FenceSpec(Record):
@@ -228,6 +273,32 @@ class NamedStart(StartSpec):
     """The robot's time in its cycle [s] when a worker from here arrives; absent: robot.task.phase."""
 
 
+class ArrivalWindow(Record):
+    """A window of the robot's cycle in which the worker may arrive."""
+
+    start: Annotated[float, Field(ge=0.0, le=MAX_CYCLE, allow_inf_nan=False)]
+    """Earliest arrival: the robot's time in its cycle [s]."""
+    end: Annotated[float, Field(ge=0.0, le=MAX_CYCLE, allow_inf_nan=False)]
+    """Latest arrival [s], at least ``start``; past the cycle's end it wraps around to its beginning."""
+
+    @model_validator(mode="after")
+    def _ordered(self) -> ArrivalWindow:
+        if self.end < self.start:
+            raise ValueError(f"end ({self.end}) must not be before start ({self.start})")
+        return self
+
+
+def _arrival_kind(v: object) -> str:
+    return "arrival-word" if isinstance(v, str) else "arrival-window"
+
+
+# "cycle", "fixed" or a window; the discriminator keeps pydantic from reporting both union branches.
+ArrivalField = Annotated[
+    Annotated[Literal["cycle", "fixed"], Tag("arrival-word")] | Annotated[ArrivalWindow, Tag("arrival-window")],
+    Discriminator(_arrival_kind),
+]
+
+
 class HumanSpec(Record):
     """The worker: where they start, their body and how they move (the paper's 30 actions)."""
 
@@ -235,6 +306,10 @@ class HumanSpec(Record):
     """The worker's start pose."""
     starts: tuple[NamedStart, ...] = Field((), max_length=MAX_COUNT)
     """Start points a search chooses from, one per episode (its first decision); empty: ``start`` only."""
+    arrival: ArrivalField = "cycle"
+    """When in the robot's cycle the worker arrives. cycle: at any time step of the cycle, and the search chooses
+    it as an episode's first decision (with the start point); fixed: at robot.task.phase (or a start point's own
+    phase), as in the paper; a window {start, end} [s]: at any time step in it."""
     anthropometry: Anthropometry = Anthropometry()
     """Body dimensions."""
     walking_speed: Annotated[float, Field(ge=0.1, le=3.0, allow_inf_nan=False)] = 1.6
@@ -275,8 +350,10 @@ class CellSpec(Record):
     """Free text; its first sentence is shown by ``cellstress cells`` and ``check``."""
     robot: RobotSpec
     """The robot."""
-    table: TableSpec
-    """The work table."""
+    table: TableSpec | None = None
+    """The work table (an obstacle of one height; absent: no table)."""
+    obstacles: tuple[ObstacleSpec, ...] = Field((), max_length=MAX_COUNT)
+    """Static obstacles besides the table, names unique."""
     fences: tuple[FenceSpec, ...] = Field((), max_length=MAX_PANELS)
     """Fences, each a polyline of panels (at most 1,024 panels in all)."""
     floor: FloorSpec
@@ -300,6 +377,33 @@ class CellSpec(Record):
                                  f"are both named {d.name!r}")
             first[d.name] = i
         return v
+
+    @field_validator("obstacles")
+    @classmethod
+    def _unique_obstacle_names(cls, v: tuple[ObstacleSpec, ...]) -> tuple[ObstacleSpec, ...]:
+        first: dict[str, int] = {}
+        for i, o in enumerate(v):
+            if o.name in first:
+                raise ValueError(f"obstacle names must be unique: obstacles[{first[o.name]}] and obstacles[{i}] "
+                                 f"are both named {o.name!r}")
+            first[o.name] = i
+        return v
+
+    @model_validator(mode="after")
+    def _obstacle_names_free(self) -> CellSpec:
+        if self.table is not None:
+            taken = {"table", *(f"table-{i + 1}" for i in range(1, len(self.table.polygons)))}
+            for i, o in enumerate(self.obstacles):
+                if o.name in taken:
+                    raise ValueError(f"obstacles[{i}] is named {o.name!r}, the name of the table's polygon")
+        return self
+
+    def solid_obstacles(self) -> tuple[ObstacleSpec, ...]:
+        """The table's polygons (named ``table``, ``table-2``, ...) and then ``obstacles``, as one list."""
+        table = () if self.table is None else tuple(
+            ObstacleSpec(name="table" if i == 0 else f"table-{i + 1}", polygon=p, height=self.table.height)
+            for i, p in enumerate(self.table.polygons))
+        return table + self.obstacles
 
     @field_validator("fences")
     @classmethod

@@ -23,6 +23,7 @@ def check(
     from cellstress.robot.capsules import declared_capsule, fitted_capsules
     from cellstress.robot.model import load_robot, resolve_urdf
     from cellstress.robot.trajectory import build_trajectory
+    from cellstress.sim.build import pedestal
 
     with spinner_while_compiling(), user_errors():
         c = load_cell(cell)
@@ -59,7 +60,10 @@ def check(
         out(f"            {k.name:<18} on joint {k.joint:>2}  radius {k.radius:.3f} m  length {length:.3f} m")
     out(f"task        {len(task.waypoints_deg)} waypoints, dwell {num(task.dwell)} s, speed scale "
         f"{num(task.speed_scale)}, phase {num(task.phase)} s, cycle time {traj.cycle:.2f} s")
-    out(f"table       {len(spec.table.polygons)} polygon(s), height {num(spec.table.height)} m")
+    obstacles = spec.solid_obstacles() + tuple(p for p in (pedestal(spec, robot),) if p is not None)
+    out(f"obstacles   {len(obstacles)}" + ("" if obstacles else " (nothing on the floor)"))
+    for o in obstacles:
+        out(f"            {o.name:<18} height {num(o.height)} m, footprint of {len(o.footprint())} corners")
     panels = sum(len(f.points) - 1 for f in spec.fences)
     out(f"fences      {len(spec.fences)} ({panels} straight segments)")
     fl = spec.floor

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Annotated
 
@@ -24,7 +25,6 @@ def new(
                                             "current folder); an existing file is never overwritten.")] = None,
 ) -> None:
     """Write a commented starter cell (a copy of the built-in 'baseline' under a new name) that passes 'check'."""
-    import re
 
     import yaml
 
@@ -41,6 +41,9 @@ def new(
     text = builtin_text("baseline")
     body = text[text.index("\nname:") + 1:]  # the built-in's own header comment is replaced
     body = body.replace("name: baseline\n", f"name: {yaml.safe_dump(name).splitlines()[0]}\n", 1)
+    # a new cell is searched over the robot's whole cycle (the built-in keeps the paper's fixed arrival)
+    body = re.sub(r"(?m)^  arrival: fixed .*$", "  arrival: cycle    # any moment of the robot's cycle, chosen by the "
+                  "search (fixed: robot.task.phase)", body, count=1)
     cell_text = HEADER.format(file=path.name) + body
     with user_errors():
         parse_cell(cell_text, str(path), path.parent)  # the starter must be valid before it is written

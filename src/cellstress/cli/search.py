@@ -70,6 +70,8 @@ def search(
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
+    from cellstress.analysis.iso13855 import check_cell
+    from cellstress.analysis.shortfall import shortfall
     from cellstress.cell.load import load_cell, with_criterion
     from cellstress.cli.report import after_search
     from cellstress.report.scope import NOT_A_PROOF, judged_by, search_scope, strongest_contact
@@ -148,6 +150,7 @@ def search(
     echo(f"criterion {judged_by(sim.criterion)}")
     best = max(result.risk_per_episode, default=0.0)
     h = result.hazard
+    static = None if h is None else check_cell(sim.cell)  # the distances a failed safeguard fell short by
     if h is None:
         echo(f"no hazard found in {result.episodes} episodes (best risk {best:.3f}; {elapsed:.2f} s, "
              f"{rate:.0f} episodes/s)")
@@ -164,6 +167,8 @@ def search(
         x, y, z = h.point
         echo(f"contact   t={num(h.time_s)} s (step {h.step}): {h.robot_link} / {h.body_part} at "
              f"({x:.3f}, {y:.3f}, {z:.3f}) m, robot moving at v_R {h.v_R:.3f} m/s")
+        if h.why is not None:
+            echo(f"why       {shortfall(h.why, static)}")
         if h.verdict is not None:  # a criterion that judges contacts: its account of this one
             name, numbers = h.verdict
             echo(f"{name:<9} {numbers.get('reason')}")
@@ -173,12 +178,16 @@ def search(
     for n, ((device, area), members) in enumerate(causes.items(), start=1):
         failed = "no device saw the worker" if device == "none" else f"{device} stopped the robot too late"
         echo(f"cause {n}   {failed}; {area} touched ({len(members)} {'class' if len(members) == 1 else 'classes'})")
+        first = result.distinct[members[0]]
+        if first.why is not None:
+            echo(f"  why     {shortfall(first.why, static)}")
         for i in members:
             d = result.distinct[i]
             cls = d.klass
             x0, y0, x1, y1 = cls.approach_cell
+            move = "" if cls.robot_move is None else f", robot's move {cls.robot_move}"
             echo(f"  class {i}  episode {d.episode}: {cls.robot_link} ({link_group(sim.layout, cls.robot_link)}) / "
-                 f"{cls.body_region}, worker at x {num(x0)}..{num(x1)}, y {num(y0)}..{num(y1)}  "
+                 f"{cls.body_region}, worker at x {num(x0)}..{num(x1)}, y {num(y0)}..{num(y1)}{move}  "
                  f"(cellstress replay {path} --hazard {i})")
     if report:
         echo(report)

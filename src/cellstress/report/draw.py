@@ -21,13 +21,15 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon, Rectangle
 
 from cellstress.core.io import atomic_write
-from cellstress.sim.build import Layout
+from cellstress.sim.build import PEDESTAL, Layout
 
 # One colour per kind of thing, used by every picture (the legend explains them once).
 FLOOR = "#f7f7f7"
 FENCE = "#2b2b2b"
 TABLE = "#dcc9a0"
 TABLE_EDGE = "#8a7446"
+OBSTACLE = "#c9c3b8"
+OBSTACLE_EDGE = "#6f6a60"
 SWEPT = "#f3c0bb"
 ROBOT = "#5a5a5a"
 ROBOT_HIT = "#d62728"
@@ -170,15 +172,14 @@ def draw_plan(ax, layout: Layout, style: PlanStyle = PlanStyle(), robot_tau: flo
     ax.add_patch(Rectangle((fl.xmin, fl.ymin), fl.xmax - fl.xmin, fl.ymax - fl.ymin, facecolor=FLOOR,
                            edgecolor="#bbbbbb", lw=1.0, zorder=0))
     handles.append(Patch(facecolor=FLOOR, edgecolor="#bbbbbb", label="floor (walkable)"))
-    for poly in spec.table.polygons:
-        ax.add_patch(Polygon(poly, closed=True, facecolor=TABLE, edgecolor=TABLE_EDGE, lw=1.0, zorder=1))
-    handles.append(Patch(facecolor=TABLE, edgecolor=TABLE_EDGE, label=f"table ({spec.table.height:g} m)"))
+    handles += draw_obstacles(ax, layout)
     if style.swept_area:
         zone = zone if zone is not None else swept_footprint(layout)
         ax.add_collection(capsule_patches(zone.a, zone.b, zone.r, facecolor=SWEPT, edgecolor="none", zorder=2))
-        # the table's edge stays visible through the (opaque) swept area
-        for poly in spec.table.polygons:
-            ax.add_patch(Polygon(poly, closed=True, fill=False, edgecolor=TABLE_EDGE, lw=0.8, ls=":", zorder=2.1))
+        # the obstacles' edges stay visible through the (opaque) swept area
+        for o in layout.obstacles:
+            ax.add_patch(Polygon(o.footprint(), closed=True, fill=False, edgecolor=obstacle_colors(o)[1], lw=0.8,
+                                 ls=":", zorder=2.1))
         handles.append(Patch(facecolor=SWEPT, label="area the robot sweeps (one cycle)"))
     for d in spec.devices:  # each device kind draws itself (core.protocols.Device.draw)
         handles.append(d.draw(ax))
@@ -217,6 +218,32 @@ def draw_plan(ax, layout: Layout, style: PlanStyle = PlanStyle(), robot_tau: flo
     ax.set_ylabel("y [m]")
     ax.grid(True, color="#dddddd", lw=0.5, zorder=-1)
     ax.set_axisbelow(True)
+    return handles
+
+
+def _is_table(o) -> bool:
+    return o.name == "table" or o.name.startswith("table-")
+
+
+def obstacle_colors(o) -> tuple[str, str]:
+    return (TABLE, TABLE_EDGE) if _is_table(o) else (OBSTACLE, OBSTACLE_EDGE)
+
+
+def draw_obstacles(ax, layout: Layout) -> list:
+    """The table's polygons and the obstacles (named, with their height), filled; returns legend handles."""
+    handles: list = []
+    tables = [o for o in layout.obstacles if _is_table(o)]
+    for o in layout.obstacles:
+        face, edge = obstacle_colors(o)
+        ax.add_patch(Polygon(o.footprint(), closed=True, facecolor=face, edgecolor=edge, lw=1.0, zorder=1))
+        if not _is_table(o) and o.name != PEDESTAL:  # (the robot base marker shows the pedestal)
+            cx, cy = np.mean(np.asarray(o.footprint(), float), axis=0)
+            ax.annotate(f"{o.name}\n{o.height:g} m", (cx, cy), ha="center", va="center", fontsize=6,
+                        color=edge, zorder=1.5, annotation_clip=True)
+    if tables:
+        handles.append(Patch(facecolor=TABLE, edgecolor=TABLE_EDGE, label=f"table ({tables[0].height:g} m)"))
+    if any(not _is_table(o) and o.name != PEDESTAL for o in layout.obstacles):
+        handles.append(Patch(facecolor=OBSTACLE, edgecolor=OBSTACLE_EDGE, label="obstacle (name, height)"))
     return handles
 
 

@@ -13,12 +13,14 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 
 from cellstress.analysis.iso13855 import StaticCheck
+from cellstress.core import plane
 from cellstress.report import draw as D
 from cellstress.report.episode import EpisodeView
 from cellstress.sim.build import Layout
 
 POSTURE_MARK = {"upright": "U", "bend-forward": "F", "bend-left": "L", "bend-right": "R",
                 "bend-forward-left": "FL", "bend-forward-right": "FR"}
+SIDE_VIEW_DEPTH = 1.2  # m: the side view shows the obstacles and fence panels this near the worker's hip
 REACH_STRIDE_STILL = 1  # still pictures use every node of the reach field (2 cm)
 
 
@@ -250,17 +252,20 @@ def contact_figure(view: EpisodeView, size: D.FigureSize = StillOptions().contac
         ax.set_aspect("equal")
     ax_top.set_xlim(lo[0], hi[0])
     ax_top.set_ylim(lo[1], hi[1])
-    # side view: floor, table and the fence panels within the picture, projected
-    t_lo = min(float(np.min(np.asarray(p)[:, u])) for p in spec.table.polygons)
-    t_hi = max(float(np.max(np.asarray(p)[:, u])) for p in spec.table.polygons)
-    ax_side.add_patch(Rectangle((t_lo, 0.0), t_hi - t_lo, spec.table.height, facecolor=D.TABLE, edgecolor=D.TABLE_EDGE,
-                                alpha=0.6, zorder=1))
+    # side view: floor, the obstacles and the fence panels near the worker, projected
+    hip = pose.a[2, :2]
+    for o in view.layout.obstacles:
+        foot = np.asarray(o.footprint(), float)
+        if plane.polygon_distance(float(hip[0]), float(hip[1]), foot) > SIDE_VIEW_DEPTH:
+            continue
+        face, edge = D.obstacle_colors(o)
+        ax_side.add_patch(Rectangle((foot[:, u].min(), 0.0), np.ptp(foot[:, u]), o.height, facecolor=face,
+                                    edgecolor=edge, alpha=0.6, zorder=1))
     # fence panels near the worker: one seen edge-on is a solid line; one running along the view is drawn as a
     # faint outline only (it stands in front of or behind the scene, not between its parts)
-    hip = pose.a[2, :2]
     for f in spec.fences:
         for a, b in zip(f.points, f.points[1:], strict=False):
-            if _point_segment_2d(hip, np.asarray(a, float), np.asarray(b, float)) > 1.2:
+            if _point_segment_2d(hip, np.asarray(a, float), np.asarray(b, float)) > SIDE_VIEW_DEPTH:
                 continue
             u0, u1 = sorted((a[u], b[u]))
             if u1 - u0 < 0.02:

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from cellstress.analysis.iso13855 import check_cell
+from cellstress.analysis.shortfall import shortfall
 from cellstress.core.errors import CellstressError
 from cellstress.report import draw as D
 from cellstress.report import html as H
@@ -93,8 +94,9 @@ def write_report(result: SearchResult | str | Path, out_dir: str | Path | None =
     acc = account(view, res.episodes)
     changed = sim.cell.sha256 != res.cell.sha256
     strongest = None if res.found else strongest_contact(sim, view.actions)
+    why = None if not res.found or res.hazard.why is None else shortfall(res.hazard.why, check_cell(sim.cell))
     page = hazard_page(res, view, acc, top, contact, gif, risk, changed, Judgement(
-        judged_by(sim.criterion), search_scope(res, sim.cell.spec, sim.layout.trajectory.cycle), strongest))
+        judged_by(sim.criterion), search_scope(res, sim.cell.spec, sim.layout.trajectory.cycle), strongest, why))
     html = H.write_page(out / NAMES[4], page)
     return ReportFiles(top, contact, gif, risk, html, acc, res.found, changed)
 
@@ -128,6 +130,7 @@ class Judgement:
     criterion: str
     scope: str
     strongest: str | None = None
+    why: str | None = None  # a hazard: why the safeguards did not prevent it (analysis.shortfall)
 
 
 def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, contact: Path, gif: Path,
@@ -143,6 +146,8 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
         if h.verdict is not None:
             name, numbers = h.verdict
             verdict += f" {e(name)}: {e(str(numbers.get('reason')))}."
+        if judgement.why is not None:
+            verdict += f"<br>Why: {e(judgement.why)}."
         verdict += f"<br>Judged by {e(judgement.criterion)}."
         body.append(f'<div class="verdict hazard">{verdict}</div>')
     else:

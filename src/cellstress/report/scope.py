@@ -8,6 +8,7 @@ from cellstress.cell.schema import CellSpec
 from cellstress.core.protocols import Criterion
 from cellstress.searchers.common import MAX_TRACKED
 from cellstress.searchers.result import SearchResult
+from cellstress.sim.starts import phase_grid
 
 NOT_A_PROOF = ("A search is not a proof: it played these sequences, not every sequence, so a hazard may remain "
                "(cellstress check gives the static ISO 13855 distances).")
@@ -26,16 +27,37 @@ def search_scope(res: SearchResult, spec: CellSpec, cycle: float) -> str:
     else:
         sequences = f" ({'at least ' if n >= MAX_TRACKED else ''}{n:,} different action sequences)"
     per = spec.simulation.actions_per_episode
+    if spec.human.arrival != "fixed":
+        return (f"{res.episodes:,} episodes of up to {per} actions{sequences}, {_where(spec, None)}, each arriving at "
+                f"a moment of the robot's cycle the search chose: {_arrival_grid(spec, cycle)} (cycle {cycle:.2f} s)")
+    return (f"{res.episodes:,} episodes of up to {per} actions{sequences}, {_where(spec, spec)} (cycle {cycle:.2f} s; "
+            "other arrival moments were not searched)")
+
+
+def _where(spec: CellSpec, with_phase: CellSpec | None) -> str:
+    """The start points, each with its robot phase when ``with_phase`` (arrival fixed)."""
     human = spec.human
+
+    def phase(p):
+        return "" if with_phase is None else f" with the robot {_phase(p, spec)} s into its cycle"
+
     if human.starts:
-        starts = ", ".join(f"{s.name} at ({s.xy[0]:g}, {s.xy[1]:g}) with the robot {_phase(s.phase, spec)} s into "
-                           "its cycle" for s in human.starts)
-        where = f"from {len(human.starts)} start points: {starts}"
+        starts = ", ".join(f"{s.name} at ({s.xy[0]:g}, {s.xy[1]:g}){phase(s.phase)}" for s in human.starts)
+        return f"from {len(human.starts)} start points: {starts}"
+    x, y = human.start.xy
+    return f"from the start point ({x:g}, {y:g}){phase(None)}"
+
+
+def _arrival_grid(spec: CellSpec, cycle: float) -> str:
+    dt = spec.simulation.dt
+    arrival = spec.human.arrival
+    if arrival == "cycle":
+        grid = [p for p in phase_grid(dt, 0.0, cycle) if p < cycle]
     else:
-        x, y = human.start.xy
-        where = f"from the start point ({x:g}, {y:g}) with the robot {_phase(None, spec)} s into its cycle"
-    return (f"{res.episodes:,} episodes of up to {per} actions{sequences}, {where} (cycle {cycle:.2f} s; other "
-            "arrival moments were not searched)")
+        grid = list(phase_grid(dt, arrival.start, arrival.end))
+    if not grid:
+        return "none"
+    return f"{len(grid):,} moments, every {dt:g} s from {grid[0]:g} to {grid[-1]:g} s"
 
 
 def _phase(phase: float | None, spec: CellSpec) -> str:

@@ -63,3 +63,36 @@ def declared_capsule(robot: RobotModel, name: str, link: str, p0, p1, radius: fl
     a = placement[:3, :3] @ np.asarray(p0, float) + placement[:3, 3]
     b = placement[:3, :3] @ np.asarray(p1, float) + placement[:3, 3]
     return Capsule(name, joint, tuple(a), tuple(b), float(radius))
+
+
+MIN_BASE_RADIUS = 0.05  # m: a base without a collision mesh still stands somewhere
+
+
+def base_footprint(robot: RobotModel) -> tuple[np.ndarray, float]:
+    """The robot's base seen from above, in the base frame: (convex hull (n x 2) of the collision meshes of the
+    links that do not move, height of their top). A base without such meshes is a small square."""
+    fixed = [v for link, v in collision_vertices(robot.urdf).items() if robot.link_joint.get(link, 0) < 0]
+    if not fixed:
+        r = MIN_BASE_RADIUS
+        return np.asarray([(-r, -r), (r, -r), (r, r), (-r, r)]), r
+    pts = np.concatenate(fixed)
+    return convex_hull_2d(pts[:, :2]), float(pts[:, 2].max())
+
+
+def convex_hull_2d(points: np.ndarray) -> np.ndarray:
+    """Counter-clockwise convex hull of plan points (Andrew's monotone chain)."""
+    pts = sorted(set(map(tuple, np.round(np.asarray(points, float), 9))))
+    if len(pts) < 3:
+        raise ValueError("a hull needs three distinct points")
+
+    def half(seq):
+        out: list = []
+        for p in seq:
+            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
+                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 0:
+                out.pop()
+            out.append(p)
+        return out
+
+    lower, upper = half(pts), half(reversed(pts))
+    return np.asarray(lower[:-1] + upper[:-1])

@@ -25,7 +25,7 @@ from cellstress.searchers.common import (
     check_common,
 )
 from cellstress.searchers.distinct import DistinctRecorder, DistinctReward, distinct_problem, hazard_class_record
-from cellstress.searchers.multistart import MultiStartProblem
+from cellstress.searchers.multistart import ArrivalProblem, PhaseProblem
 from cellstress.searchers.result import (
     FORMAT,
     CellRef,
@@ -36,6 +36,7 @@ from cellstress.searchers.result import (
     TopEpisode,
 )
 from cellstress.searchers.slices import ClassRecorder, cell_starts, run_slices
+from cellstress.searchers.why import explain
 from cellstress.sim.simulator import Simulator
 
 DEFAULT_BUDGET = 200
@@ -127,8 +128,9 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
     reward = sim.criterion.reward(sim.actions_per_episode)
     problem = sim
     names = None
-    if c.spec.human.starts:
-        problem = MultiStartProblem(sim)
+    searched_phase = c.spec.human.arrival != "fixed"
+    if c.spec.human.starts or searched_phase:
+        problem = ArrivalProblem(sim) if c.spec.human.starts else PhaseProblem(sim)
         names = problem.names
     rec = None
     missing = [p.__name__ for p in getattr(type(s), "needs", ()) if not isinstance(problem, p)]
@@ -197,7 +199,8 @@ def hazard_record(sim: Simulator, episode: int, actions: list[str]) -> Hazard:
     return Hazard.model_construct(
         episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.t, robot_link=hit.robot_link,
         body_part=hit.body_part, point=hit.robot_point, human_point=hit.human_point, v_R=hit.v_R, d_HR=hit.d_HR,
-        trace=records, **({} if verdict is None else {sim.criterion.type: verdict.as_dict()}))
+        trace=records, why=explain(trace.layout, records, trace.unsafe_row),
+        **({} if verdict is None else {sim.criterion.type: verdict.as_dict()}))
 
 
 def distinct_record(sim: Simulator, klass, episode: int, actions: list[str]) -> DistinctHazard:
@@ -206,4 +209,5 @@ def distinct_record(sim: Simulator, klass, episode: int, actions: list[str]) -> 
     hit = records[trace.unsafe_row]
     return DistinctHazard.model_construct(
         klass=klass, episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.t,
-        robot_link=hit.robot_link, body_part=hit.body_part, v_R=hit.v_R, trace=records)
+        robot_link=hit.robot_link, body_part=hit.body_part, v_R=hit.v_R, trace=records,
+        why=explain(trace.layout, records, trace.unsafe_row))

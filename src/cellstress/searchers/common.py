@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cellstress.core.errors import CellstressError
+from cellstress.core.protocols import StartChoices
 
 UNTIL = ("first", "budget")
 
@@ -139,6 +140,15 @@ class Outcome:
         return self.hazards[0] if self.hazards else None
 
 
+def first_range(problem) -> int:
+    """The range an episode's first decision is drawn from: the actions, or a problem's first choices if there are
+    more of them (``searchers.multistart``: a start point and an arrival phase); the problem maps a draw onto its
+    choices (modulo), so with fewer choices than actions the draws are the same as for a plain problem."""
+    if isinstance(problem, StartChoices):
+        return max(problem.n_actions, problem.choices(0))
+    return problem.n_actions
+
+
 def rollout(problem, reward, state, actions: list[int], risk: float, rng: np.random.Generator):
     """Play uniformly random actions from ``state`` to the horizon; ``actions`` (the prefix) is extended.
 
@@ -148,6 +158,10 @@ def rollout(problem, reward, state, actions: list[int], risk: float, rng: np.ran
     if depth >= n or problem.is_unsafe(state):
         return 0.0, risk, problem.is_unsafe(state)
     draws = rng.integers(0, problem.n_actions, size=n - depth).tolist()
+    if depth == 0 and isinstance(rng, np.random.Generator):  # (a pre-drawn row already holds its first decision)
+        first = first_range(problem)
+        if first > problem.n_actions:
+            draws[0] = int(rng.integers(first))
     total = 0.0
     for k, a in enumerate(draws, start=depth):
         state, rows = problem.step(state, a)

@@ -25,12 +25,14 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from cellstress.core.protocols import StartChoices
 from cellstress.core.records import Measures
 from cellstress.human.regions import body_region, region_group
 from cellstress.searchers.common import Recorder, Stop
 from cellstress.searchers.result import HazardClass
-from cellstress.sim.layout import M_FWD, M_HEADING, M_HX, M_HZ, M_LAT, M_LINK, M_PART, M_X, M_Y, S_TRIG_DEV
+from cellstress.sim.layout import M_FWD, M_HEADING, M_HX, M_HZ, M_LAT, M_LINK, M_PART, M_TAU, M_X, M_Y, S_TRIG_DEV
 from cellstress.sim.scene import body_pose
 
 CELL_SIZE = 0.5
@@ -45,7 +47,13 @@ def hazard_class(sim, state, row) -> tuple:
     pose = body_pose(lay, row[M_X], row[M_Y], row[M_HEADING], row[M_FWD], row[M_LAT])
     b = lay.body
     region = body_region(int(row[M_PART]), row[M_HX:M_HZ + 1], pose, b.height, b.upper_arm, b.forearm)
-    return (device, link, region, math.floor(row[M_X] / CELL_SIZE), math.floor(row[M_Y] / CELL_SIZE))
+    key = (device, link, region, math.floor(row[M_X] / CELL_SIZE), math.floor(row[M_Y] / CELL_SIZE))
+    if sim.cell.spec.human.arrival == "fixed":
+        return key
+    # the arrival is searched: the same contact in another move of the robot's program is another class
+    traj = lay.trajectory
+    move = int(np.searchsorted(traj.starts, float(row[M_TAU]) % traj.cycle, side="right"))
+    return (*key, max(move, 1))
 
 
 def link_group(layout, link: str) -> str:
@@ -68,10 +76,11 @@ def root_cause(klass: HazardClass) -> tuple[str, str]:
 
 def hazard_class_record(key: tuple) -> HazardClass:
     """The class key of ``hazard_class`` as the result file's record."""
-    device, link, region, cx, cy = key
+    device, link, region, cx, cy = key[:5]
     return HazardClass.model_construct(device=device, robot_link=link, body_region=region,
                                        approach_cell=(cx * CELL_SIZE, cy * CELL_SIZE, (cx + 1) * CELL_SIZE,
-                                                      (cy + 1) * CELL_SIZE))
+                                                      (cy + 1) * CELL_SIZE),
+                                       robot_move=key[5] if len(key) > 5 else None)
 
 
 class DistinctProblem:

@@ -64,7 +64,7 @@ from typing import ClassVar
 import numpy as np
 
 from cellstress.core.protocols import CellRows, Lookahead, NoveltyAware, SafetyIndexReward
-from cellstress.searchers.common import MAX_BUDGET, Recorder, SearchError, number, whole
+from cellstress.searchers.common import MAX_BUDGET, Recorder, SearchError, first_range, number, whole
 from cellstress.sim.layout import M_D, M_PHASE, M_V, PHASE_RUNNING
 
 EVOLVE_KEY = 3
@@ -133,17 +133,22 @@ class Evolve:
 
         sticky = [self.sticky]  # the start's random episodes may use their own (init_sticky)
 
-        def draw(prev: int, avoid: int) -> int:
+        first = first_range(problem)  # the first decision's range (start points x arrival phases, or actions)
+
+        def draw(prev: int, avoid: int, at: int) -> int:
+            n = first if at == 0 else n_actions
+            if prev >= n:  # (a first choice beyond the actions is no action to repeat)
+                prev = -1
             if prev >= 0 and prev != avoid and rng.random() < sticky[0]:
                 return prev
             if avoid < 0:
-                return int(rng.integers(n_actions))
-            a = int(rng.integers(n_actions - 1))
+                return int(rng.integers(n))
+            a = int(rng.integers(n - 1))
             return a + (a >= avoid)
 
         def tail(actions: list[int]) -> list[int]:
             while len(actions) < horizon:
-                actions.append(draw(actions[-1] if actions else -1, -1))
+                actions.append(draw(actions[-1] if actions else -1, -1, len(actions)))
             return actions
 
         # distinct mode (search.slices): a hazard of a class already found is worth nothing, never a parent
@@ -191,7 +196,7 @@ class Evolve:
                 else:
                     j = int(rng.integers(min(k_best + 1, horizon - 1) + 1))
                 child = parent[:j]
-                child.append(draw(child[-1] if child else -1, parent[j] if j < len(parent) else -1))
+                child.append(draw(child[-1] if child else -1, parent[j] if j < len(parent) else -1, j))
                 if rng.random() < self.keep_tail and len(parent) == horizon:
                     child += parent[j + 1:]
                 else:

@@ -57,7 +57,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from cellstress.core.protocols import WorkerModel
+from cellstress.core.protocols import StartChoices, WorkerModel
 from cellstress.searchers.common import Recorder, SearchError, number, whole
 from cellstress.searchers.evolve import REDRAWS
 from cellstress.sim import layout as L
@@ -101,7 +101,10 @@ class Plan:
                               "add --distinct: each start point then gets its own searches)")
         rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(PLAN_KEY,)))
         horizon, n_actions = problem.actions_per_episode, problem.n_actions
-        model = _Model(problem)
+        # a cell whose arrival phase is searched: the first decision is the phase (multistart.PhaseProblem)
+        lead = 1 if isinstance(problem, StartChoices) else 0
+        n_first = problem.choices(0) if lead else 0
+        model = _Model(problem, lead)
         # played sequence -> its least d_HR before any device reacted; a key shorter than the horizon is an
         # episode cut short by a hazard (with until="budget"), which any sequence beginning with it would replay
         closest: dict[tuple[int, ...], float] = {}
@@ -111,7 +114,10 @@ class Plan:
 
         def sticky_tail(actions: list[int], repeat: float) -> list[int]:
             while len(actions) < horizon:
-                prev = actions[-1] if actions else -1
+                if len(actions) < lead:
+                    actions.append(int(rng.integers(n_first)))
+                    continue
+                prev = actions[-1] if len(actions) > lead else -1
                 actions.append(prev if prev >= 0 and rng.random() < repeat else int(rng.integers(n_actions)))
             return actions
 
@@ -147,7 +153,7 @@ class Plan:
                 else:
                     parent = parents[int(rng.integers(len(parents)))]
                     j = int(rng.integers(horizon))
-                    child = parent[:j] + [int(rng.integers(n_actions))]
+                    child = parent[:j] + [int(rng.integers(n_first if j < lead else n_actions))]
                     if rng.random() < self.keep_tail:
                         child += parent[j + 1:]
                     child = sticky_tail(child, self.sticky)
@@ -166,14 +172,19 @@ class Plan:
 class _Model:
     """What ``plan`` has learned of the robot and the devices, and its predictions (module docstring)."""
 
-    def __init__(self, sim):
+    def __init__(self, sim, lead: int = 0):
         self.sim = sim
-        self.spa, self.horizon = sim.steps_per_action, sim.actions_per_episode
+        # ``lead`` = 1: a sequence's first decision is the robot's phase at arrival (``PhaseProblem``); the robot's
+        # path then runs from that phase, so what is learned of it is kept per phase step + time step
+        self.lead = lead
+        self.spa, self.horizon = sim.steps_per_action, sim.actions_per_episode - lead
         self.n_steps = self.horizon * self.spa
+        self.offsets = np.asarray([sim.phase_step(c) for c in range(sim.choices(0))] if lead else [0], dtype=np.int64)
+        n_path = int(self.offsets.max()) + self.n_steps + 1
         self.v_tol = float(sim.params.scal[L.C_VTOL])
         self.pose_cols = [L.M_X, L.M_Y, L.M_HEADING, L.M_FWD, L.M_LAT]
-        self.points: list[dict] = [{} for _ in range(self.n_steps + 1)]  # step -> {cell: (point, offset)}
-        self.speed = np.full(self.n_steps + 1, np.nan)  # v_R on the programmed path, per step (1-based)
+        self.points: list[dict] = [{} for _ in range(n_path)]  # path step -> {cell: (point, offset)}
+        self.speed = np.full(n_path, np.nan)  # v_R on the programmed path, per path step
         self.delays: dict[int, list[tuple[int, int]]] = {}  # device mask -> [(to braking, to standstill)]
         # played prefix -> (its rows' count, devices seen per row, first braking and standstill row or -1)
         self.prefixes: dict[tuple[int, ...], tuple[int, np.ndarray, int, int]] = {}
@@ -187,11 +198,13 @@ class _Model:
                                 wh * np.sin(poses[:, 2]), wf * poses[:, 3], wf * poses[:, 4]])
 
     def learn(self, actions: list[int], rows: np.ndarray) -> None:
+        base = int(self.offsets[actions[0] % len(self.offsets)]) if self.lead else 0
+        rows = rows[self.lead:]  # (a first decision's row is the initial state's)
         seen = rows[:, L.M_SEEN].astype(np.int64)
         braking = np.flatnonzero(rows[:, L.M_PHASE] >= L.PHASE_BRAKING)
         stopped = np.flatnonzero(rows[:, L.M_PHASE] >= L.PHASE_STOPPED)
-        for p in range(1, len(actions) + 1):
-            n = min(p * self.spa, len(rows))
+        for p in range(1 + self.lead, len(actions) + 1):
+            n = min((p - self.lead) * self.spa, len(rows))
             b = int(braking[0]) if len(braking) and braking[0] < n else -1
             s = int(stopped[0]) if len(stopped) and stopped[0] < n else -1
             self.prefixes[tuple(actions[:p])] = (n, seen[:n], b, s)
@@ -200,7 +213,7 @@ class _Model:
             pts = on_path[:, [L.M_RX, L.M_RY, L.M_RZ]]
             reach = self.sim.worker_distances(on_path[:, self.pose_cols], pts[:, None, :])[:, 0]
             for row, point, dist in zip(on_path, pts, reach, strict=True):
-                k = int(row[L.M_STEP])
+                k = base + int(row[L.M_STEP])
                 self.speed[k] = row[L.M_V]
                 cell = tuple(np.round(point / POINT_GRID).astype(int))
                 offset = float(dist - row[L.M_D])
@@ -220,8 +233,8 @@ class _Model:
         """The robot points and offsets of every step, padded with NaN points: (steps + 1, m, 3), (steps + 1, m)."""
         if self._by_step is None:
             m = max(1, max(len(p) for p in self.points))
-            pts = np.full((self.n_steps + 1, m, 3), np.nan)
-            off = np.zeros((self.n_steps + 1, m))
+            pts = np.full((len(self.points), m, 3), np.nan)
+            off = np.zeros((len(self.points), m))
             for k, found in enumerate(self.points):
                 for i, (point, offset) in enumerate(found.values()):
                     pts[k, i], off[k, i] = point, offset
@@ -236,7 +249,7 @@ class _Model:
         if self._tree is None:
             self._tree = (cKDTree(np.concatenate(self.feats)), np.concatenate(self.seen))
         tree, seen_at = self._tree
-        poses = self.sim.worker_paths(seqs).reshape(-1, 5)
+        poses = self.sim.worker_paths(seqs[:, self.lead:]).reshape(-1, 5)
         seen = seen_at[tree.query(self._features(poses))[1]].reshape(n, steps)
         known = np.zeros(n, dtype=np.int64)
         played_brake = np.full(n, -1)
@@ -266,6 +279,8 @@ class _Model:
         # the robot step each candidate step meets (0-based step k -> row step k + 1; braking: its first step)
         k = np.arange(steps)[None, :]
         robot_step = np.minimum(k, brake[:, None]) + 1
+        if self.lead:
+            robot_step = robot_step + self.offsets[seqs[:, 0] % len(self.offsets)][:, None]
         use = (k >= known[:, None]) & (k < stop[:, None]) & (np.nan_to_num(self.speed[robot_step]) > self.v_tol)
         pts, off = self._step_points()
         which = np.flatnonzero(use.ravel())

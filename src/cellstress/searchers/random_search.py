@@ -15,7 +15,7 @@ import numpy as np
 
 from cellstress.core.protocols import BatchSimulator
 from cellstress.core.records import Measures
-from cellstress.searchers.common import Recorder, rollout, whole
+from cellstress.searchers.common import Recorder, first_range, rollout, whole
 
 RANDOM_KEY = 2
 
@@ -40,10 +40,13 @@ class RandomSearch:
     def run(self, problem, reward, rec: Recorder, seed: int) -> None:
         rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(RANDOM_KEY,)))
         n, na = problem.actions_per_episode, problem.n_actions
+        first = first_range(problem)
         batch = problem.run_batch if isinstance(problem, BatchSimulator) else None
         s0 = problem.reset()
         while True:
             acts = rng.integers(0, na, size=(self.chunk, n))
+            if first > na:  # more first choices than actions (start points x arrival phases)
+                acts[:, 0] = rng.integers(0, first, size=self.chunk)
             m = min(rec.left, self.chunk)
             if batch is None:
                 for e in range(m):

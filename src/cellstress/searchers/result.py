@@ -57,6 +57,9 @@ class HazardClass(Record):
     robot_link: Name
     body_region: Name
     approach_cell: tuple[float, float, float, float]
+    # a cell whose arrival phase is searched (absent otherwise): the move of the robot's program at the contact,
+    # 1-based (move i runs from waypoint i to the next, its dwell at waypoint i included)
+    robot_move: Annotated[int, Field(ge=1, le=100_000)] | None = None
 
 
 class EpisodeRef(Record):
@@ -70,6 +73,35 @@ class TopEpisode(Record):
     ret: float | None = Field(alias="return")
     risk: float | None
     unsafe: bool
+
+
+class DeviceTiming(Record):
+    """One safety device in a hazardous episode: when it first saw the worker, and when its stop took effect."""
+
+    device: Name
+    saw_at_s: float | None
+    """First time the device saw the worker [s]; None: never, up to the contact."""
+    stop_at_s: float | None
+    """When the stop it asked for took effect (saw_at_s plus its response time) [s]."""
+
+
+class Why(Record):
+    """Why a hazardous episode was not prevented, from its timeline (``searchers.why``)."""
+
+    detected: bool
+    """Did any device see the worker before the contact?"""
+    devices: Annotated[tuple[DeviceTiming, ...], Field(max_length=1000)]
+    """Every device of the cell, in the cell's order."""
+    stopped_by: Name | None
+    """The device whose stop took effect first; None: undetected."""
+    braking_from_s: float | None
+    """When the robot began to brake [s]."""
+    standstill_at_s: float | None
+    """When the robot stood (or would have stood) still [s]."""
+    contact_at_s: float
+    """The unsafe contact [s]."""
+    late_by_s: float | None
+    """How much earlier the robot needed to stand still: standstill_at_s - contact_at_s [s]."""
 
 
 class Hazard(Record):
@@ -89,6 +121,7 @@ class Hazard(Record):
     v_R: float | None
     d_HR: float | None
     trace: Trace
+    why: Why | None = None  # absent from files written before it was recorded
 
     @model_validator(mode="after")
     def _one_verdict(self) -> Hazard:
@@ -120,6 +153,7 @@ class DistinctHazard(Record):
     body_part: Name | None
     v_R: float | None
     trace: Trace
+    why: Why | None = None  # absent from files written before it was recorded
 
 
 class SearchResult(Record):
@@ -150,6 +184,12 @@ class SearchResult(Record):
         for key in ("distinct", "distinct_sequences"):
             if doc[key] is None:
                 del doc[key]
+        for d in doc.get("distinct") or ():
+            if d["class"]["robot_move"] is None:
+                del d["class"]["robot_move"]
+        for h in (doc["hazard"], *(doc.get("distinct") or ())):
+            if h is not None and h.get("why", 0) is None:
+                del h["why"]
         if doc["cell"]["criterion"] is None:
             del doc["cell"]["criterion"]
         return json_ready(doc)

@@ -36,9 +36,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cellstress.core.protocols import StartChoices
 from cellstress.searchers.common import Outcome, Recorder, Stop
 from cellstress.searchers.distinct import hazard_class
-from cellstress.searchers.multistart import MultiStartProblem
+from cellstress.searchers.multistart import ArrivalProblem, PhaseProblem
 
 SLICE_KEY = 7
 SLICE_LEN = 200  # evolve finds S2, the hardest single flaw, within 200 episodes in 166 of 200 seeds (results.md)
@@ -57,6 +58,16 @@ class Start:
     prefix: tuple[int, ...] = ()
     ret0: float = 0.0
     risk0: float = 0.0
+    # a start point whose problem chooses the phase first (a PhaseProblem): (its index, the number of starts),
+    # so that its first decision j is recorded as the whole cell's first decision index + starts * j
+    phased: tuple[int, int] | None = None
+
+    def recorded(self, actions: tuple[int, ...]) -> tuple[int, ...]:
+        """A slice's episode as the whole cell's ``ArrivalProblem`` records it."""
+        if self.phased is None:
+            return (*self.prefix, *actions)
+        i, m = self.phased
+        return (i + m * (actions[0] % self.problem.n_choices), *actions[1:])
 
 
 class CellStart:
@@ -81,22 +92,29 @@ class CellStart:
         key = tuple(int(a) for a in actions)
         cls = self._classes.get(key)
         if cls is None:
-            state = self.sim.reset()
-            for a in key:
-                state, rows = self.sim.step(state, a)
-                if self.sim.is_unsafe(state):
+            sim, acts = self.sim, key
+            if isinstance(sim, StartChoices):  # the first decision picks the arrival: replay in its simulator
+                sim, acts = sim.simulator(key[0]), key[1:]
+            state = sim.reset()
+            for a in acts:
+                state, rows = sim.step(state, a)
+                if sim.is_unsafe(state):
                     break
             else:
                 raise ValueError(f"not an unsafe episode: {key}")
-            cls = self._classes[key] = hazard_class(self.sim, state, rows[-1])
+            cls = self._classes[key] = hazard_class(sim, state, rows[-1])
         return cls
 
 
 def cell_starts(problem, reward) -> list[Start]:
     """The start points of a cell's problem: a ``MultiStartProblem`` (one per ``human.starts`` entry, with
     its first decision's reward) or a ``SimProblem`` (one start, no prefix)."""
-    if not isinstance(problem, MultiStartProblem):
+    if not isinstance(problem, ArrivalProblem):
         return [Start(CellStart(problem))]
+    if not problem.starts:  # one start point: its problem chooses the phase (a PhaseProblem)
+        return [Start(CellStart(problem))]
+    if problem.n_phases > 1:  # each start point's slices choose its phase themselves
+        return [Start(CellStart(PhaseProblem(problem.sim, i)), phased=(i, problem.m)) for i in range(problem.m)]
     out = []
     for i, sim in enumerate(problem.sims):
         _, rows = problem.step(problem.reset(), i)  # the first decision, exactly as MultiStartProblem plays it
@@ -134,7 +152,7 @@ class _Slice:
         if rec.episodes >= rec.budget:
             raise Stop
         acts = tuple(int(a) for a in actions)
-        recorded = (*st.prefix, *acts)
+        recorded = st.recorded(acts)
         new = False
         if unsafe:
             cls = st.problem.class_of(acts)

@@ -8,11 +8,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from cellstress.cell.load import Cell
+from cellstress.cell.schema import ObstacleSpec
 from cellstress.core.records import ScanPlane, VerticalField
 from cellstress.human.actions import action_table
 from cellstress.human.body import BodyDimensions
 from cellstress.human.reach import ReachField, reach_field
-from cellstress.robot.capsules import Capsule, declared_capsule, fitted_capsules
+from cellstress.robot.capsules import Capsule, base_footprint, declared_capsule, fitted_capsules
 from cellstress.robot.model import RobotModel, load_robot, resolve_urdf
 from cellstress.robot.trajectory import Trajectory, build_trajectory
 from cellstress.sim import kernels as K
@@ -77,6 +78,33 @@ class Layout:
     reach: ReachField
     device_names: tuple[str, ...]
     params: K.SimParams
+    obstacles: tuple[ObstacleSpec, ...] = ()  # the table's polygons, the cell's obstacles, the robot's pedestal
+
+
+PEDESTAL = "robot-pedestal"
+
+
+def pedestal(spec, robot: RobotModel) -> ObstacleSpec | None:
+    """The robot's base as an obstacle: its footprint from the floor to the top of its fixed links."""
+    if spec.robot.pedestal == "none":
+        return None
+    hull, top = base_footprint(robot)
+    m = _base_matrix(spec.robot.base.xyz, spec.robot.base.yaw_deg)
+    world = hull @ m[:2, :2].T + m[:2, 3]
+    height = float(m[2, 3]) + top
+    if height <= 0.0:
+        return None
+    return ObstacleSpec.model_construct(name=PEDESTAL, polygon=tuple(map(tuple, world.tolist())), box=None,
+                                        height=height)
+
+
+def obstacle_arrays(obstacles) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(vertices, (start, count) rows, bounding box and height rows) of the obstacles' footprints."""
+    feet = [np.asarray(o.footprint(), dtype=float) for o in obstacles]
+    verts, index = pack_polygons(feet)
+    box = np.asarray([(f[:, 0].min(), f[:, 0].max(), f[:, 1].min(), f[:, 1].max(), o.height)
+                      for f, o in zip(feet, obstacles, strict=True)], dtype=float).reshape(-1, 5)
+    return verts, index, box
 
 
 def _base_matrix(xyz, yaw_deg) -> np.ndarray:
@@ -112,7 +140,9 @@ def build_layout(cell: Cell) -> Layout:
 
     fences = [(a[0], a[1], b[0], b[1], f.bottom, f.top)
               for f in spec.fences for a, b in zip(f.points, f.points[1:], strict=False)]
-    table_verts, table_poly = pack_polygons(spec.table.polygons)
+    ped = pedestal(spec, robot)
+    obstacles = spec.solid_obstacles() + (() if ped is None else (ped,))
+    obs_verts, obs_poly, obs_box = obstacle_arrays(obstacles)
 
     dev = device_arrays(spec.devices)
 
@@ -148,8 +178,9 @@ def build_layout(cell: Cell) -> Layout:
         cap_r=np.asarray([c.radius for c in caps], dtype=float),
         reach=np.ascontiguousarray(reach.values),
         fences=np.asarray(fences, dtype=float).reshape(-1, 6),
-        table_verts=table_verts,
-        table_poly=table_poly,
+        obs_verts=obs_verts,
+        obs_poly=obs_poly,
+        obs_box=obs_box,
         floor=np.asarray([spec.floor.xmin, spec.floor.xmax, spec.floor.ymin, spec.floor.ymax], dtype=float),
         dev_kind=dev.kind,
         dev_resp=dev.response,
@@ -162,7 +193,7 @@ def build_layout(cell: Cell) -> Layout:
         pre_tau=np.zeros(0),
     )
     params = _with_robot_table(params, spec)
-    return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params)
+    return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params, obstacles)
 
 
 def _with_robot_table(params: K.SimParams, spec) -> K.SimParams:

@@ -176,6 +176,36 @@ def segment_rectangle_xyz(ax, ay, az, bx, by, bz, x0, y0, x1, y1, zlo, zhi):
     return np.sqrt(best), c1x, c1y, c1z, c2x, c2y, c2z
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def capsule_touches_prism(ax, ay, az, bx, by, bz, r, verts, start, count, h):
+    """True when the capsule (segment ab, radius r) comes closer than r to the prism that raises the polygon
+    verts[start:start+count] from the floor to height h.
+
+    Only the part of the segment at most r above the top can come that close, so it is clipped to z <= h + r.
+    A point of that part over the polygon is within r of the prism (inside it, or above its top); otherwise the
+    closest point lies on a side wall, and a part that passes over the polygon crosses a wall's plan line
+    below h + r, within r of that wall. So: an end of the clipped part over the polygon, or a side wall within r.
+    """
+    top = h + r
+    if az > top and bz > top:
+        return False
+    if az > top:
+        t = (top - bz) / (az - bz)
+        ax, ay, az = bx + t * (ax - bx), by + t * (ay - by), top
+    elif bz > top:
+        t = (top - az) / (bz - az)
+        bx, by, bz = ax + t * (bx - ax), ay + t * (by - ay), top
+    if point_in_polygon(ax, ay, verts, start, count) or point_in_polygon(bx, by, verts, start, count):
+        return True
+    j = start + count - 1
+    for i in range(start, start + count):
+        if segment_rectangle_xyz(ax, ay, az, bx, by, bz, verts[j, 0], verts[j, 1], verts[i, 0], verts[i, 1],
+                                 0.0, h)[0] < r:
+            return True
+        j = i
+    return False
+
+
 @njit(cache=True, error_model="numpy")
 def segment_crosses_rectangle(a, b, rect):
     """True when segment ab passes through the vertical rectangle (strictly crossing its plane)."""

@@ -27,7 +27,7 @@ from cellstress.sim.build import Layout, build_layout, with_phase
 from cellstress.sim.contacts import ContactModel
 from cellstress.sim.lookahead import Lookahead
 from cellstress.sim.records import STOP_PHASES, StepRecord
-from cellstress.sim.starts import START_PREFIX, split_start
+from cellstress.sim.starts import is_arrival_token, split_start
 
 
 @dataclass(frozen=True)
@@ -264,7 +264,7 @@ class Simulator:
     def run(self, actions) -> Trace:
         """Play a whole action sequence from s0 (stopping at the first unsafe step). A leading ``start:NAME``
         plays it from that start point of the cell's ``human.starts`` (see ``search.multistart``)."""
-        if len(actions) and isinstance(actions[0], str) and actions[0].startswith(START_PREFIX):
+        if len(actions) and is_arrival_token(actions[0]):
             sim, rest = split_start(self, actions)
             return sim.run(rest)
         acts = np.asarray([action_index(a) for a in actions], dtype=np.int64)

@@ -30,8 +30,9 @@ class SimParams(NamedTuple):
     cap_r: np.ndarray  # (nc,)
     reach: np.ndarray  # (n, n, n) float32 signed distance
     fences: np.ndarray  # (nf, 6) x0 y0 x1 y1 zlo zhi
-    table_verts: np.ndarray  # (V, 2)
-    table_poly: np.ndarray  # (T, 2) int64 start, count
+    obs_verts: np.ndarray  # (V, 2) obstacle footprints (the table's polygons first)
+    obs_poly: np.ndarray  # (O, 2) int64 start, count into obs_verts
+    obs_box: np.ndarray  # (O, 5) footprint bounding box xmin xmax ymin ymax, and the obstacle's height
     floor: np.ndarray  # (4,) xmin xmax ymin ymax
     dev_kind: np.ndarray  # (nd,) int64
     dev_resp: np.ndarray  # (nd,)

@@ -7,7 +7,7 @@ import numpy as np
 from numba import njit
 
 from cellstress.human.body import WALK_BLOCK_HEIGHT
-from cellstress.sim.geometry import point_segment_2d, polygon_distance, segment_rectangle_xyz
+from cellstress.sim.geometry import capsule_touches_prism, point_segment_2d, polygon_distance, segment_rectangle_xyz
 from cellstress.sim.layout import B_HEAD_RISE, B_R_HEAD, B_R_TRUNK, B_SHOULDER_HALF, DEV_SCANNER, N_BODY_CAPSULES
 
 
@@ -52,12 +52,13 @@ def device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def feet_ok(r, fl, table_verts, table_poly, fences, x, y):
-    """The footprint circle (radius r) stays on the floor, off the table and clear of fence panels."""
+def feet_ok(r, fl, obs_verts, obs_poly, fences, x, y):
+    """The footprint circle (radius r) stays on the floor, off every obstacle (the table's among them: the worker
+    never climbs onto one, however low) and clear of fence panels."""
     if x - r < fl[0] or x + r > fl[1] or y - r < fl[2] or y + r > fl[3]:
         return False
-    for t in range(table_poly.shape[0]):
-        if polygon_distance(x, y, table_verts, table_poly[t, 0], table_poly[t, 1]) < r:
+    for t in range(obs_poly.shape[0]):
+        if polygon_distance(x, y, obs_verts, obs_poly[t, 0], obs_poly[t, 1]) < r:
             return False
     for f in range(fences.shape[0]):
         if fences[f, 4] < WALK_BLOCK_HEIGHT and \
@@ -67,12 +68,27 @@ def feet_ok(r, fl, table_verts, table_poly, fences, x, y):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def trunk_clear(body, fences, ha, hb, hr):
-    """Trunk, head and arms (from the shoulders down) do not pass through any fence panel.
+def trunk_clear(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr):
+    """Trunk, head and arms (from the shoulders down) do not pass through any fence panel, and trunk and head
+    do not enter any obstacle.
 
     The shoulders matter most: the reach volumes hang on them, so a shoulder past a panel would reach
-    around it for free. (Where the hands can get past a panel is limited separately, by fence_detour.)
+    around it for free. (Where the hands can get past a panel is limited separately, by fence_detour.) The
+    hanging arms are not held off obstacles: bent over a table they would hit its top, which the model's fixed
+    arm pose cannot avoid (the articulated worker can); the reach volumes ignore obstacles likewise.
     """
+    for o in range(obs_poly.shape[0]):
+        h = obs_box[o, 4]
+        for c in (2, 3):
+            r = hr[c]
+            if min(ha[c, 2], hb[c, 2]) - r >= h:
+                continue
+            if min(ha[c, 0], hb[c, 0]) - r > obs_box[o, 1] or max(ha[c, 0], hb[c, 0]) + r < obs_box[o, 0] or \
+                    min(ha[c, 1], hb[c, 1]) - r > obs_box[o, 3] or max(ha[c, 1], hb[c, 1]) + r < obs_box[o, 2]:
+                continue
+            if capsule_touches_prism(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2], r, obs_verts,
+                                     obs_poly[o, 0], obs_poly[o, 1], h):
+                return False
     extent = body[B_HEAD_RISE] + body[B_R_HEAD] + body[B_SHOULDER_HALF]
     for f in range(fences.shape[0]):
         x0, y0, x1, y1, zlo, zhi = fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3], fences[f, 4], fences[f, 5]

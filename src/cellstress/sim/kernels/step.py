@@ -139,7 +139,7 @@ def move_worker(P, state, action, h0, f0, l0, frac, W):
     """The worker's own motion over one time step of ``action`` (begun at heading h0 and posture f0, l0):
     ``frac`` of the action done. It depends on the actions and the fixed layout only, never on the robot."""
     walks = P.act[action, 0]
-    body, fences, floor, table_verts, table_poly = P.body, P.fences, P.floor, P.table_verts, P.table_poly
+    body, fences, floor, obs_verts, obs_poly, obs_box = P.body, P.fences, P.floor, P.obs_verts, P.obs_poly, P.obs_box
     ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
     x, y = state[S_X], state[S_Y]
     h = h0 + P.act[action, 1] * frac
@@ -149,14 +149,14 @@ def move_worker(P, state, action, h0, f0, l0, frac, W):
     if walks != 0.0:
         stride = body[B_WALK_SPEED] * P.scal[C_DT]
         nx, ny = x + stride * np.cos(h), y + stride * np.sin(h)
-        if not feet_ok(body[B_BODY_RADIUS], floor, table_verts, table_poly, fences, nx, ny):
+        if not feet_ok(body[B_BODY_RADIUS], floor, obs_verts, obs_poly, fences, nx, ny):
             nx, ny = x, y
     # If the new posture would put the trunk through a fence, keep the old posture where it stands; if that
     # fails too, stay put. (A loop, so that pose_body and trunk_clear are inlined once, not twice: each
     # copy cost seconds of a cold compile, in step_action and worker_paths alike.)
     for attempt in range(2):
         pose_body(body, nx, ny, h, f, lt, ha, hb, hr, sh, tr)
-        if trunk_clear(body, fences, ha, hb, hr):
+        if trunk_clear(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr):
             break
         h, f, lt = state[S_HEADING], state[S_FWD], state[S_LAT]
         if attempt == 1:

@@ -1,0 +1,33 @@
+"""Why a hazard happened, in words: the episode's timeline (``searchers.why``) next to the static ISO 13855
+distances of the safeguard that should have prevented it (required S against where it stands), or, when no
+device saw the worker, the undetected reach against the arm allowance."""
+
+from __future__ import annotations
+
+from cellstress.analysis.iso13855 import StaticCheck
+from cellstress.searchers.result import Why
+from cellstress.searchers.why import why_words
+
+
+def distance_words(why: Why, static: StaticCheck) -> str:
+    """What the static check says about the safeguard that failed (empty when it has nothing to add)."""
+    if why.detected:
+        for d in static.devices:
+            if d.device == why.stopped_by:
+                verdict = ("short by" if not d.ok else "met, with")
+                gap = abs(d.actual - d.required)
+                return (f"ISO 13855 requires S = {d.required:.2f} m; {d.device} stands {d.actual:.2f} m from the "
+                        f"hazard zone ({verdict} {gap:.2f} m)")
+        return ""
+    a = static.approach
+    if a.distance == float("inf"):
+        return "the static check finds no undetected reach to the hazard zone"
+    verdict = "short by" if not a.ok else "met, with"
+    return (f"undetected reach: the shortest arm path from where no device sees the worker is {a.distance:.2f} m, "
+            f"{a.arm_allowance:.2f} m needed ({verdict} {abs(a.distance - a.arm_allowance):.2f} m)")
+
+
+def shortfall(why: Why, static: StaticCheck | None) -> str:
+    """The timeline and, when the static check is at hand, the distances: one sentence."""
+    extra = "" if static is None else distance_words(why, static)
+    return why_words(why) + (f"; {extra}" if extra else "")

@@ -1,0 +1,79 @@
+"""Why a hazard was not prevented: the timeline in result.json agrees with the trace's own stop phases, and the
+words name the safeguard and its ISO 13855 shortfall."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from cellstress.analysis.iso13855 import check_cell
+from cellstress.analysis.replay import check_result
+from cellstress.analysis.shortfall import shortfall
+from cellstress.searchers import search
+from cellstress.searchers.result import SearchResult
+from cellstress.searchers.why import explain
+from cellstress.sim.simulator import Simulator
+
+
+@pytest.fixture(scope="module")
+def s1():
+    return Simulator("s1-scanner-width")
+
+
+def test_undetected_hazard(tmp_path):
+    res = search(Simulator("s3-fence-gap"), "plan", budget=200, seed=0)
+    why = res.hazard.why
+    assert not why.detected and why.stopped_by is None and why.late_by_s is None
+    assert all(t.saw_at_s is None for t in why.devices)
+    words = shortfall(why, check_cell(Simulator("s3-fence-gap").cell))
+    assert words.startswith("undetected") and "short by" in words
+
+
+def test_detected_too_late(s1):
+    res = search(s1, "plan", budget=200, seed=0)
+    why, h = res.hazard.why, res.hazard
+    assert why.detected and why.stopped_by == "front-scanner"
+    first = next(t for t in why.devices if t.device == why.stopped_by)
+    assert first.stop_at_s == pytest.approx(first.saw_at_s + 0.35)
+    assert why.standstill_at_s == pytest.approx(first.stop_at_s + s1.cell.spec.robot.stopping_time)
+    assert why.contact_at_s == h.time_s and why.late_by_s > 0
+    words = shortfall(why, check_cell(s1.cell))
+    assert "front-scanner saw the worker at 0.50 s" in words and "ISO 13855 requires S = 1.88 m" in words
+
+
+@pytest.mark.parametrize("cell", ["s1-scanner-width", "s2-elbow-intrusion", "all-flaws"])
+def test_timeline_agrees_with_the_trace(cell):
+    sim = Simulator(cell)
+    rng = np.random.default_rng(7)
+    acts = rng.integers(0, 30, size=(3000, 8))
+    unsafe = np.flatnonzero(sim.run_batch(acts).unsafe)
+    assert len(unsafe) > 0
+    for e in unsafe[:40]:
+        trace = sim.run(acts[e].tolist())
+        recs = trace.records()
+        why = explain(sim.layout, recs, trace.unsafe_row)
+        hit = recs[trace.unsafe_row]
+        braking = [r.t for r in recs if r.stop_phase in ("braking", "stopped")]
+        if not why.detected:
+            assert hit.stop_phase == "running" and not any(r.devices for r in recs)
+            continue
+        # the stop the timeline names is the one the simulator applied
+        if braking:
+            assert braking[0] == pytest.approx(why.braking_from_s, abs=1e-9)
+        else:
+            assert why.braking_from_s >= hit.t - 1e-9
+        assert hit.stop_phase != "stopped" or why.late_by_s <= 1e-9
+
+
+def test_old_files_without_the_timeline_still_replay(s1, tmp_path):
+    res = search(s1, "plan", budget=200, seed=0)
+    doc = json.loads(res.to_json())
+    del doc["hazard"]["why"]
+    path = tmp_path / "result.json"
+    path.write_text(json.dumps(doc))
+    old = SearchResult.load(path)
+    assert old.hazard.why is None
+    check = check_result(old, search_again=True)
+    assert check.reproduced, check.problems
