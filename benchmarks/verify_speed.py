@@ -53,7 +53,7 @@ def own_phase(cell: str, repeats: int) -> None:
 def all_phases(cell: str, workers: int, fraction: float) -> None:
     sim = Simulator(cell)
     options = VerifyOptions(phases="all")
-    tasks = tasks_of(sim.cell, sim.layout.trajectory.cycle, options, None)
+    tasks = tasks_of(sim, options, None)
     step = max(1, round(1 / fraction))
     chosen = tasks[::step]
     cpu0, t0 = _cpu(), time.perf_counter()

@@ -44,7 +44,7 @@ def test_worker_touching_the_moving_robot_at_the_start(tmp_path) -> None:
     path = _cell_file(tmp_path, "touch", "{xy: [-1.25, -0.2], heading_deg: 0.0}", 0.75)
     res = cellstress.verify(path, horizon=3, phases="cell", out=tmp_path / "out")
     assert res.verdict == "UNSAFE" and res.hazardous == 30 ** 3 and res.subtrees[0].probability == 1.0
-    assert len(res.classes) == 1 and res.classes[0].actions == ()
+    assert len(res.classes) == 1 and res.classes[0].actions == ("phase:0.75",)  # unsafe before any action
     assert SearchResult.load(tmp_path / "out" / res.classes[0].file).found
 
 

@@ -14,7 +14,7 @@ import cellstress
 from cellstress.cell.load import BUILTIN_CELLS
 from cellstress.sim.simulator import Simulator
 from cellstress.verifier.bounds import Bounds
-from cellstress.verifier.phases import start_points
+from cellstress.verifier.phases import arrival_phases, start_points
 from cellstress.verifier.tree import decide, lookup
 
 
@@ -29,8 +29,7 @@ def _brute_force(sim: Simulator, k: int) -> int:
 def _start_sim(cell: str, phase: float | None = None) -> Simulator:
     sim = Simulator(cell)
     s = start_points(sim.cell)[0]
-    own = sim.cell.spec.robot.task.phase if s.phase is None else s.phase
-    return sim.with_start(s.pose, own if phase is None else phase)
+    return sim.with_start(s.pose, arrival_phases(sim, s, "cell")[0] if phase is None else phase)
 
 
 @pytest.mark.parametrize(("cell", "phase"), [(c, None) for c in BUILTIN_CELLS] + [("s1-scanner-width", 3.0)])

@@ -88,7 +88,7 @@ def _search_again(res: SearchResult, sim: Simulator) -> list[str]:
     from the sequence."""
     try:
         if res.searcher == WITNESS_SEARCHER and res.hazard is not None:
-            again = witness_result(sim, list(res.hazard.actions), res.params, res.cell.source)
+            again = witness_result(sim, list(res.hazard.actions), res.cell.source)
         else:
             again = search(sim, res.searcher, res.budget, res.seed, until=res.until, top_k=len(res.top),
                            distinct=res.distinct is not None, **res.params)

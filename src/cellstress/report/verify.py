@@ -90,6 +90,6 @@ def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None
         x0, y0, x1, y1 = k.approach_cell
         lines.append(f"class {i:<3} {failed}; {k.robot_link} / {k.body_region}, worker at x {x0:g}..{x1:g}, "
                      f"y {y0:g}..{y1:g}; {w.sequences:,} sequences; first at "
-                     f"{w.start}, phase {w.phase:g} s: {', '.join(w.actions) or '(no action: unsafe at the start)'}")
+                     f"{w.start}, phase {w.phase:g} s: {', '.join(w.actions)}")
         lines.append(f"          cellstress replay {where}")
     return lines

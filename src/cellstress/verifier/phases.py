@@ -1,16 +1,18 @@
-"""Which start points and arrival phases a verification decides: the one place that reads them from a cell.
+"""Which start points and arrival phases a verification decides: the one place that chooses them.
 
-An arrival phase is the robot's path time when the worker's episode starts (``robot.task.phase``, or a start
-point's own ``phase``). ``all`` decides every phase of the robot's cycle on the simulation's time grid,
-i * dt for i in range(ceil(cycle / dt)) (rounded to 1 ns, so that 0.15 is written 0.15); ``cell`` only the
-phases the cell gives. (When the cell format gains an arrival window, ``human.arrival``, this is the function
-that reads it.)
+An arrival phase is the robot's path time when the worker's episode starts. ``all`` decides every time step of
+the robot's cycle, k * dt for k * dt < cycle (rounded to 1 ns, as ``sim.starts.phase_grid`` names them), for
+every start point, whatever the cell says; ``cell`` decides the phases the cell's ``human.arrival`` allows
+(``sim.starts.arrival_phases``: ``fixed``, the cell's own phase or a start point's; ``cycle``, every time step of
+the cycle; a window, every time step in it).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+
+from cellstress.sim.starts import arrival_phases as cell_phases
+from cellstress.sim.starts import phase_grid
 
 PHASE_MODES = ("all", "cell")
 DEFAULT_START = "start"  # the name of a cell's only start point (``human.start``) in verify's output
@@ -18,13 +20,13 @@ DEFAULT_START = "start"  # the name of a cell's only start point (``human.start`
 
 @dataclass(frozen=True)
 class StartPoint:
-    """A start pose, named as the cell names it; ``phase``: its own arrival phase (None: the robot task's)."""
+    """A start pose as the cell names it; ``spec``: its ``human.starts`` entry (None: ``human.start``)."""
 
     name: str
     x: float
     y: float
     heading_deg: float
-    phase: float | None = None
+    spec: object = None
 
     @property
     def pose(self) -> tuple[float, float, float]:
@@ -35,20 +37,18 @@ def start_points(cell) -> tuple[StartPoint, ...]:
     """The cell's start points: each of ``human.starts``, or ``human.start`` alone."""
     human = cell.spec.human
     if human.starts:
-        return tuple(StartPoint(s.name, float(s.xy[0]), float(s.xy[1]), float(s.heading_deg), s.phase)
+        return tuple(StartPoint(s.name, float(s.xy[0]), float(s.xy[1]), float(s.heading_deg), s)
                      for s in human.starts)
     s = human.start
     return (StartPoint(DEFAULT_START, float(s.xy[0]), float(s.xy[1]), float(s.heading_deg)),)
 
 
-def arrival_phases(cell, start: StartPoint, cycle: float, mode: str = "all") -> tuple[float, ...]:
-    """The arrival phases [s] to decide for ``start`` (``mode``: ``all`` or ``cell``, see the module); ``cycle``
-    is the robot's cycle time (``Layout.trajectory.cycle``)."""
+def arrival_phases(sim, start: StartPoint, mode: str = "all") -> tuple[float, ...]:
+    """The arrival phases [s] to decide for ``start`` in ``sim``'s cell (``mode``: ``all`` or ``cell``, see the
+    module)."""
     if mode not in PHASE_MODES:
         raise ValueError(f"phases must be one of {', '.join(PHASE_MODES)}, not {mode!r}")
-    own = float(cell.spec.robot.task.phase if start.phase is None else start.phase)
     if mode == "cell":
-        return (own,)
-    dt = float(cell.spec.simulation.dt)
-    n = max(1, math.ceil(cycle / dt - 1e-9))  # a cycle that is a whole number of steps is not one step longer
-    return tuple(round(i * dt, 9) for i in range(n))
+        return cell_phases(sim, start.spec)
+    cycle = float(sim.layout.trajectory.cycle)
+    return tuple(p for p in phase_grid(sim.dt, 0.0, cycle) if p < cycle)  # the cycle's end is its start

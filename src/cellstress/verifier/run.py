@@ -17,7 +17,7 @@ from pydantic import ValidationError
 from cellstress.cell.load import Cell
 from cellstress.core.errors import CellstressError
 from cellstress.core.version import __version__
-from cellstress.human.actions import ACTION_NAMES, N_ACTIONS
+from cellstress.human.actions import N_ACTIONS
 from cellstress.searchers.distinct import hazard_class, hazard_class_record, root_cause
 from cellstress.searchers.result import CellRef
 from cellstress.sim.layout import M_STEP, M_T
@@ -36,7 +36,7 @@ from cellstress.verifier.records import (
     Witness,
 )
 from cellstress.verifier.tree import QUANT_ANGLE, QUANT_XY, decide
-from cellstress.verifier.witness import write_witness
+from cellstress.verifier.witness import witness_actions, write_witness
 
 WITNESS_DIR = "witness-{:02d}"
 
@@ -123,20 +123,20 @@ def _init_worker() -> None:
     numba.set_num_threads(1)  # one thread per worker process: N workers on N cores
 
 
-def tasks_of(cell: Cell, cycle: float, options: VerifyOptions, deadline: float | None) -> list[Task]:
+def tasks_of(sim: Simulator, options: VerifyOptions, deadline: float | None) -> list[Task]:
     """The sub-trees of a verification, in the order of the result."""
-    return [Task(cell, s, p, options, deadline) for s in start_points(cell)
-            for p in arrival_phases(cell, s, cycle, options.phases)]
+    return [Task(sim.cell, s, p, options, deadline) for s in start_points(sim.cell)
+            for p in arrival_phases(sim, s, options.phases)]
 
 
 def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out: str | Path | None = None,
                progress: Callable[[int, int], None] | None = None) -> VerifyResult:
     """Decide ``sim``'s cell (see ``cellstress.api.verify``). ``progress(sequences decided, of)``; ``out``: a folder
-    for ``verify.json`` and one witness per hazard class (``witness-NN/result.json`` and its ``cell.yaml``)."""
+    for ``verify.json`` and one witness per hazard class (``witness-NN/result.json``)."""
     cell = sim.cell
     _SIMS[(cell.sha256, cell.spec.criterion.type)] = sim
     deadline = None if options.time_limit is None else time.time() + options.time_limit
-    tasks = tasks_of(cell, sim.layout.trajectory.cycle, options, deadline)
+    tasks = tasks_of(sim, options, deadline)
     total = len(tasks) * N_ACTIONS ** options.horizon
     done = [0]
 
@@ -178,13 +178,13 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
     for c in classes.values():
         task, f = c["task"], c["found"]
         rel = f"{WITNESS_DIR.format(c['index'] + 1)}/result.json"
+        actions = witness_actions(cell, task.start, task.phase, f.actions)
         if out is not None:
-            write_witness(sim, cell, task.start, task.phase, f.actions, Path(out) / WITNESS_DIR.format(c["index"] + 1))
+            write_witness(sim, actions, Path(out) / WITNESS_DIR.format(c["index"] + 1))
         klass = hazard_class_record(f.key)
         witnesses.append(Witness.model_construct(
             klass=klass, root_cause=root_cause(klass), start=task.start.name, phase=task.phase,
-            actions=tuple(ACTION_NAMES[a] for a in f.actions), step=f.step, time_s=f.time_s,
-            sequences=c["sequences"], file=rel))
+            actions=actions, step=f.step, time_s=f.time_s, sequences=c["sequences"], file=rel))
     hazardous = sum(s.hazardous for s in subtrees)
     undecided = sum(s.undecided for s in subtrees)
     pruned: dict[str, list[int]] = {}
