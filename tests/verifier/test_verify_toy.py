@@ -63,6 +63,7 @@ def test_command_exit_codes_and_replayable_witnesses(tmp_path, capsys) -> None:
     assert main(["verify", "s1-scanner-width", "--phases", "cell", "--horizon", "5", "--out", str(out)]) == 1
     doc = json.loads((out / "verify.json").read_text())
     assert doc["verdict"] == "UNSAFE" and doc["hazardous"] > 0 and (out / "verify.png").is_file()
+    assert doc["classes"][0]["file"] in (out / "verify.html").read_text()
     witness = out / doc["classes"][0]["file"]
     assert main(["replay", str(witness)]) == 0
     assert "REPRODUCED bit-exactly" in capsys.readouterr().out

@@ -44,7 +44,7 @@ def verify(
 
     from cellstress.cell.load import load_cell, with_criterion
     from cellstress.report.scope import judged_by
-    from cellstress.report.verify import PNG_NAME, hazard_map, summary_lines
+    from cellstress.report.verify import HTML_NAME, PNG_NAME, hazard_map, summary_lines, verify_page
     from cellstress.sim.simulator import Simulator
     from cellstress.verifier.run import verify_cell
 
@@ -72,7 +72,8 @@ def verify(
         raise typer.Exit(INTERRUPTED) from None
     elapsed = time.perf_counter() - t0
     png = hazard_map(res, out_dir / PNG_NAME)
+    page = verify_page(res, png, out_dir / HTML_NAME, judged_by(sim.criterion))
     for line in summary_lines(res, judged_by(sim.criterion), str(out_dir)):
         say(line)
-    say(f"wrote     {out_dir / 'verify.json'}, {png} ({elapsed:.1f} s)")
+    say(f"wrote     {out_dir / 'verify.json'}, {png.name}, {page.name} ({elapsed:.1f} s)")
     raise typer.Exit(res.exit_code)

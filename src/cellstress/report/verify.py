@@ -3,15 +3,18 @@ summary ``cellstress verify`` prints."""
 
 from __future__ import annotations
 
+from html import escape
 from pathlib import Path
 
 import numpy as np
 from matplotlib.colors import ListedColormap, LogNorm
 
 from cellstress.report import draw as D
+from cellstress.report import html as H
 from cellstress.verifier.records import PROVED_SAFE, UNDECIDED, UNSAFE, VerifyResult
 
 PNG_NAME = "verify.png"
+HTML_NAME = "verify.html"
 MAP_SIZE = D.FigureSize(9.0, 3.6, 100)
 SAFE_COLOUR = "#d9f0d3"
 UNDECIDED_COLOUR = "#bdbdbd"
@@ -93,3 +96,28 @@ def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None
                      f"{w.start}, phase {w.phase:g} s: {', '.join(w.actions)}")
         lines.append(f"          cellstress replay {where}")
     return lines
+
+
+def verify_page(res: VerifyResult, png: str | Path, path: str | Path, criterion_text: str) -> Path:
+    """``verify.html``: the verdict, the proof's size, the hazard map, the hazardous sub-trees and each hazard
+    class with its witness (self-contained, like every report page)."""
+    lines = summary_lines(res, criterion_text)
+    verdict = next(ln for ln in lines if ln.startswith(res.verdict))
+    body = [f"<h1>{escape(res.cell.name)}: {escape(res.verdict)}</h1>",
+            f'<div class="verdict {"safe" if res.verdict == PROVED_SAFE else "hazard"}">{escape(verdict)}</div>',
+            H.table(None, [[ln.split(" ", 1)[0], ln.split(" ", 1)[1].strip()] for ln in lines[:3 + len(res.pruned)]]),
+            H.figure(png, "Hazard map: arrival phases x start points", "hazard map"),
+            "<h2>Sub-trees</h2>",
+            H.table(["start", "phase [s]", "verdict", "hazardous", "of", "P(hazard)", "undecided", "states"],
+                    [[s.start, f"{s.phase:g}", s.verdict, f"{s.hazardous:,}", f"{s.sequences:,}",
+                      f"{s.probability:.3e}", f"{s.undecided:,}", f"{sum(s.states):,}"] for s in res.subtrees
+                     if s.verdict != PROVED_SAFE] or [["(every sub-tree proved safe)", "", "", "", "", "", "", ""]],
+                    numeric={1, 3, 4, 5, 6, 7})]
+    if res.classes:
+        body += ["<h2>Hazard classes and their witnesses</h2>",
+                 H.table(["class", "device", "robot link / body region", "sequences", "witness", "file"],
+                         [[i, w.klass.device, f"{w.klass.robot_link} / {w.klass.body_region}", f"{w.sequences:,}",
+                           ", ".join(w.actions), w.file] for i, w in enumerate(res.classes, start=1)],
+                         numeric={0, 3})]
+    return H.write_page(path, H.page(f"verify {res.cell.name}", body,
+                                     f"cellstress {res.version}; replay a witness with: cellstress replay FILE"))
