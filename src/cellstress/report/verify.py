@@ -59,9 +59,11 @@ def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None
     hazardous sub-trees and each hazard class with its witness."""
     o = res.options
     n_starts = len({s.start for s in res.subtrees})
+    n_phases = len({s.phase for s in res.subtrees})
     lines = [
-        f"cell      {res.cell.name}  horizon {o.horizon} actions  phases {o.phases} ({len(res.subtrees)} sub-trees: "
-        f"{n_starts} start point{'s' if n_starts != 1 else ''} x arrival phases)",
+        f"cell      {res.cell.name}  horizon {o.horizon} actions  phases {o.phases} ({len(res.subtrees)} "
+        f"sub-tree{'s' if len(res.subtrees) != 1 else ''}: {n_starts} start point{'s' if n_starts != 1 else ''}, "
+        f"{n_phases} arrival phase{'s' if n_phases != 1 else ''})",
         f"criterion {criterion_text}",
         f"decided   {res.sequences - res.undecided:,} of {res.sequences:,} action sequences; {res.states:,} distinct "
         f"states visited",
