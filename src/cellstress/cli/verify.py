@@ -20,12 +20,13 @@ from cellstress.cli.common import (
 
 def verify(
     cell: Annotated[str, typer.Argument(help=CELL_HELP)],
-    out: Annotated[str, typer.Option("--out", "-o", help="Folder for verify.json, verify.png and one witness "
-                                     "per hazard class (witness-NN/result.json).")],
+    out: Annotated[str, typer.Option("--out", "-o", help="Folder for verify.json, verify.png, verify.html and "
+                                     "one witness per hazard class (witness-NN/result.json).")],
     horizon: Annotated[int | None, typer.Option("--horizon", help="Actions per episode (default: the cell's "
                                                 "simulation.actions_per_episode; at most 12).")] = None,
     phases: Annotated[str, typer.Option("--phases", help="all: every arrival phase of the robot's cycle on the "
-                                        "time-step grid; cell: only the phases the cell gives.")] = "all",
+                                        "time-step grid; cell: only the phases the cell's "
+                                        "human.arrival allows.")] = "all",
     time_limit: Annotated[float | None, typer.Option("--time-limit", help="Seconds; what is not decided by "
                                                      "then is reported as undecided (exit code 3).")] = None,
     workers: Annotated[int | None, typer.Option("--workers", help="Processes deciding sub-trees in parallel "
