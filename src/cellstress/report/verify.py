@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.colors import ListedColormap, LogNorm
+from matplotlib.ticker import FuncFormatter, NullFormatter
 
 from cellstress.report import draw as D
 from cellstress.report import html as H
@@ -18,6 +19,7 @@ HTML_NAME = "verify.html"
 MAP_SIZE = D.FigureSize(9.0, 3.6, 100)
 SAFE_COLOUR = "#d9f0d3"
 UNDECIDED_COLOUR = "#bdbdbd"
+MAX_LISTED = 12  # hazardous sub-trees listed one by one in the summary
 
 
 @D.plain_text
@@ -43,6 +45,10 @@ def hazard_map(res: VerifyResult, path: str | Path, size: D.FigureSize = MAP_SIZ
                         extent=extent, interpolation="nearest")
         bar = fig.colorbar(img, cax=fig.add_axes((0.9, 0.28, 0.02, 0.56)))
         bar.set_label("P(hazard), uniform worker", fontsize=8)
+        # plain tick labels: mathtext is off in every picture (names from files), and log ticks would use it
+        bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.0e}"))
+        bar.ax.yaxis.set_minor_formatter(NullFormatter())
+        bar.ax.tick_params(labelsize=7)
     ax.set_yticks(range(len(starts)), starts, fontsize=8)
     step = max(1, len(phases) // 12)
     ax.set_xticks(range(0, len(phases), step), [f"{phases[k]:g}" for k in range(0, len(phases), step)], fontsize=8)
@@ -81,10 +87,14 @@ def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None
     else:
         lines.append(f"UNSAFE: {res.hazardous:,} of {res.sequences:,} sequences hazardous "
                      f"(p = {res.hazardous / res.sequences:.3e} for a uniformly random worker)")
-    for s in res.subtrees:
-        if s.hazardous:
-            lines.append(f"  {s.start} at phase {s.phase:g} s: {s.hazardous:,} of {s.sequences:,} hazardous "
-                         f"(p = {s.probability:.3e})")
+    hazardous = [s for s in res.subtrees if s.hazardous]
+    for s in hazardous[:MAX_LISTED]:
+        lines.append(f"  {s.start} at phase {s.phase:g} s: {s.hazardous:,} of {s.sequences:,} hazardous "
+                     f"(p = {s.probability:.3e})")
+    if len(hazardous) > MAX_LISTED:
+        worst = max(hazardous, key=lambda s: s.hazardous)
+        lines.append(f"  ... {len(hazardous) - MAX_LISTED} more hazardous sub-trees (verify.json, verify.html); the "
+                     f"most: {worst.start} at phase {worst.phase:g} s (p = {worst.probability:.3e})")
     undecided = [s for s in res.subtrees if s.undecided]
     for s in undecided:
         lines.append(f"  undecided: {s.start} at phase {s.phase:g} s ({s.undecided:,} sequences)")
