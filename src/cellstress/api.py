@@ -5,6 +5,7 @@
     verdict = cellstress.check(cell)                  # the static ISO 13855 / 13857 check
     result = cellstress.search(cell, searcher="plan", budget=200, seed=0)
     trace = cellstress.simulate(cell, ["walk+bend-right", "walk+bend-forward"])
+    proof = cellstress.verify("baseline", phases="cell")  # every action sequence decided exactly
     cellstress.write_report(result, "out/s3")
 
 Each accepts what the command line accepts (a built-in cell name or a cell file's path, or a ``Cell``), raises
@@ -26,6 +27,8 @@ from cellstress.searchers import DEFAULT_BUDGET, DEFAULT_TOP_K
 from cellstress.searchers import search as _search
 from cellstress.searchers.result import SearchResult
 from cellstress.sim.simulator import Simulator, Trace
+from cellstress.verifier.records import VerifyResult
+from cellstress.verifier.run import verify_cell
 
 CellLike = Cell | str | Path
 
@@ -83,3 +86,18 @@ def write_report(result: SearchResult | str | Path, out: str | Path | None = Non
     """Write the report of a search result (pictures, animation, report.html) into ``out`` (default: the
     result file's folder)."""
     return _write_report(result, out)
+
+
+def verify(cell: CellLike, *, horizon: int | None = None, phases: str = "all", time_limit: float | None = None,
+           workers: int = 1, out: str | Path | None = None, criterion: str | None = None,
+           progress: Callable[[int, int], None] | None = None) -> VerifyResult:
+    """Decide exactly whether any sequence of ``horizon`` worker actions (default: the cell's
+    ``actions_per_episode``) reaches the unsafe set, from every start point, at every arrival phase of the robot's
+    cycle on the time-step grid (``phases="all"``) or at the cell's own phases (``"cell"``).
+
+    ``.verdict`` is ``PROVED-SAFE``, ``UNSAFE`` or ``UNDECIDED`` (``time_limit`` [s] ran out; never a proof);
+    ``.hazardous`` the exact number of hazardous sequences, per sub-tree in ``.subtrees``; ``.classes`` one witness
+    per hazard class. ``workers`` processes decide sub-trees in parallel; ``out``: a folder for verify.json and
+    the witnesses' replayable result files. docs/verify.md says what a proof means."""
+    return verify_cell(Simulator(_cell(cell, criterion)), horizon=horizon, phases=phases, time_limit=time_limit,
+                       workers=workers, out=out, progress=progress)

@@ -23,6 +23,8 @@ from cellstress.searchers import distinct_record, hazard_record, search
 from cellstress.searchers.common import SearchError
 from cellstress.searchers.result import DistinctHazard, Hazard, SearchResult
 from cellstress.sim.simulator import Simulator, Trace
+from cellstress.verifier.witness import SEARCHER as WITNESS_SEARCHER
+from cellstress.verifier.witness import witness_result
 
 MAX_LISTED_DIFFERENCES = 4
 
@@ -81,10 +83,15 @@ def _distinct(res: SearchResult, index: int) -> DistinctHazard:
 
 
 def _search_again(res: SearchResult, sim: Simulator) -> list[str]:
-    """The search re-run from the file's own settings, compared field by field with the file."""
+    """The search re-run from the file's own settings, compared field by field with the file. A witness of
+    ``cellstress verify`` is a one-episode file whose every claim follows from its sequence: it is made again
+    from the sequence."""
     try:
-        again = search(sim, res.searcher, res.budget, res.seed, until=res.until, top_k=len(res.top),
-                       distinct=res.distinct is not None, **res.params)
+        if res.searcher == WITNESS_SEARCHER and res.hazard is not None:
+            again = witness_result(sim, list(res.hazard.actions), res.cell.source)
+        else:
+            again = search(sim, res.searcher, res.budget, res.seed, until=res.until, top_k=len(res.top),
+                           distinct=res.distinct is not None, **res.params)
     except SearchError as exc:
         return [f"searcher, params: the recorded search cannot be run again ({exc})"]
     recorded, rerun = res.to_dict(), again.to_dict()

@@ -1,7 +1,7 @@
 """The ``cellstress`` command line: one module per command, shared helpers in ``cli.common``.
 
 Exit codes: 0 success, 1 a finding or a failed check the user asked about, 2 a user error (one line
-``error: ...`` on stderr, no traceback).
+``error: ...`` on stderr, no traceback), 3 ``verify`` left sequences undecided (its time limit).
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from cellstress.cli.report import report, show
 from cellstress.cli.schema import schema
 from cellstress.cli.search import search
 from cellstress.cli.simulate import simulate
+from cellstress.cli.verify import verify
 from cellstress.core.errors import CellstressError
 
 app = typer.Typer(
@@ -29,7 +30,7 @@ app = typer.Typer(
     rich_markup_mode=None,
     help="Find hidden human-robot hazards in industrial robot cells.",
 )
-for command in (cells, check, simulate, search, replay, campaign, report, show, schema, new):
+for command in (cells, check, simulate, search, verify, replay, campaign, report, show, schema, new):
     app.command()(command)
 
 

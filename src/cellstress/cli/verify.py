@@ -1,0 +1,80 @@
+"""``cellstress verify``: decide every sequence of worker actions, at every arrival phase and start point."""
+
+from __future__ import annotations
+
+import os
+from typing import Annotated
+
+import typer
+
+from cellstress.cli.common import (
+    CELL_HELP,
+    INTERRUPTED,
+    check_criterion,
+    check_out_dir,
+    criterion_help,
+    say,
+    user_errors,
+)
+
+
+def verify(
+    cell: Annotated[str, typer.Argument(help=CELL_HELP)],
+    out: Annotated[str, typer.Option("--out", "-o", help="Folder for verify.json, verify.png, verify.html and "
+                                     "one witness per hazard class (witness-NN/result.json).")],
+    horizon: Annotated[int | None, typer.Option("--horizon", help="Actions per episode (default: the cell's "
+                                                "simulation.actions_per_episode; at most 12).")] = None,
+    phases: Annotated[str, typer.Option("--phases", help="all: every arrival phase of the robot's cycle on the "
+                                        "time-step grid; cell: only the phases the cell's "
+                                        "human.arrival allows.")] = "all",
+    time_limit: Annotated[float | None, typer.Option("--time-limit", help="Seconds; what is not decided by "
+                                                     "then is reported as undecided (exit code 3).")] = None,
+    workers: Annotated[int | None, typer.Option("--workers", help="Processes deciding sub-trees in parallel "
+                                                "(default: all cores).")] = None,
+    criterion: Annotated[str | None, typer.Option("--criterion", help=criterion_help("the cell file's"))] = None,
+) -> None:
+    """Decide exactly whether any sequence of the worker's actions reaches the unsafe set: every sequence, from
+    every start point, at every arrival phase of the robot's cycle (a proof within the model, not a search).
+
+    Exit code 0 PROVED-SAFE, 1 UNSAFE (one witness per hazard class, replayable), 2 a bad input, 3 UNDECIDED
+    (the time limit left sequences undecided)."""
+    import time
+
+    from rich.console import Console
+    from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+    from cellstress.cell.load import load_cell, with_criterion
+    from cellstress.report.scope import judged_by
+    from cellstress.report.verify import HTML_NAME, PNG_NAME, hazard_map, summary_lines, verify_page
+    from cellstress.sim.simulator import Simulator
+    from cellstress.verifier.run import verify_cell
+
+    with user_errors():
+        check_criterion(criterion)
+    out_dir = check_out_dir(out)
+    console = Console(stderr=True)
+    bar = Progress(SpinnerColumn(), TextColumn("[bold]deciding"), BarColumn(),
+                   TextColumn("{task.percentage:>5.1f} % of {task.fields[of]} sequences"), TimeElapsedColumn(),
+                   console=console, transient=True, disable=not console.is_terminal)
+    task = bar.add_task("verify", total=1, of="?")
+
+    def tick(done: int, total: int) -> None:
+        bar.update(task, completed=done, total=total, of=f"{total:.3g}")
+
+    t0 = time.perf_counter()
+    try:
+        with bar, user_errors():
+            sim = Simulator(with_criterion(load_cell(cell), criterion))
+            res = verify_cell(sim, horizon=horizon, phases=phases, time_limit=time_limit,
+                              workers=os.cpu_count() or 1 if workers is None else workers, out=out_dir,
+                              progress=tick)
+    except KeyboardInterrupt:
+        say("interrupted: nothing was decided (run the same command again)", err=True)
+        raise typer.Exit(INTERRUPTED) from None
+    elapsed = time.perf_counter() - t0
+    png = hazard_map(res, out_dir / PNG_NAME)
+    page = verify_page(res, png, out_dir / HTML_NAME, judged_by(sim.criterion))
+    for line in summary_lines(res, judged_by(sim.criterion), str(out_dir)):
+        say(line)
+    say(f"wrote     {out_dir / 'verify.json'}, {png.name}, {page.name} ({elapsed:.1f} s)")
+    raise typer.Exit(res.exit_code)

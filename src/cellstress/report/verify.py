@@ -1,0 +1,135 @@
+"""The report of a verification: the hazard map (``verify.png``: arrival phases x start points) and the text
+summary ``cellstress verify`` prints."""
+
+from __future__ import annotations
+
+from html import escape
+from pathlib import Path
+
+import numpy as np
+from matplotlib.colors import ListedColormap, LogNorm
+from matplotlib.ticker import FuncFormatter, NullFormatter
+
+from cellstress.report import draw as D
+from cellstress.report import html as H
+from cellstress.verifier.records import PROVED_SAFE, UNDECIDED, UNSAFE, VerifyResult
+
+PNG_NAME = "verify.png"
+HTML_NAME = "verify.html"
+MAP_SIZE = D.FigureSize(9.0, 3.6, 100)
+SAFE_COLOUR = "#d9f0d3"
+UNDECIDED_COLOUR = "#bdbdbd"
+MAX_LISTED = 12  # hazardous sub-trees listed one by one in the summary
+
+
+@D.plain_text
+def hazard_map(res: VerifyResult, path: str | Path, size: D.FigureSize = MAP_SIZE) -> Path:
+    """One row per start point, one column per arrival phase: the exact probability that a uniformly random
+    worker reaches the unsafe set (log colour scale), proved-safe sub-trees green, undecided ones grey."""
+    starts = list(dict.fromkeys(s.start for s in res.subtrees))
+    phases = sorted({s.phase for s in res.subtrees})
+    grid = np.full((len(starts), len(phases)), np.nan)
+    status = np.zeros(grid.shape, dtype=int)  # 0 safe, 1 unsafe, 2 undecided
+    for s in res.subtrees:
+        i, j = starts.index(s.start), phases.index(s.phase)
+        grid[i, j] = s.probability if s.hazardous else np.nan
+        status[i, j] = 1 if s.verdict == UNSAFE else 2 if s.verdict == UNDECIDED else 0
+    fig = D.new_figure(size)
+    ax = fig.add_axes((0.14, 0.28, 0.74, 0.56))
+    extent = (-0.5, len(phases) - 0.5, len(starts) - 0.5, -0.5)
+    ax.imshow(np.where(status == 2, 1.0, 0.0), cmap=ListedColormap([SAFE_COLOUR, UNDECIDED_COLOUR]), vmin=0, vmax=1,
+              aspect="auto", extent=extent, interpolation="nearest")
+    if np.isfinite(grid).any():
+        lo = float(np.nanmin(grid))
+        img = ax.imshow(grid, cmap="Reds", norm=LogNorm(vmin=min(lo, 0.99e-1), vmax=1.0), aspect="auto",
+                        extent=extent, interpolation="nearest")
+        bar = fig.colorbar(img, cax=fig.add_axes((0.9, 0.28, 0.02, 0.56)))
+        bar.set_label("P(hazard), uniform worker", fontsize=8)
+        # plain tick labels: mathtext is off in every picture (names from files), and log ticks would use it
+        bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.0e}"))
+        bar.ax.yaxis.set_minor_formatter(NullFormatter())
+        bar.ax.tick_params(labelsize=7)
+    ax.set_yticks(range(len(starts)), starts, fontsize=8)
+    step = max(1, len(phases) // 12)
+    ax.set_xticks(range(0, len(phases), step), [f"{phases[k]:g}" for k in range(0, len(phases), step)], fontsize=8)
+    ax.set_xlabel("arrival phase: the robot's time in its cycle when the worker arrives [s]", fontsize=8)
+    ax.set_title(f"{res.cell.name}: {res.verdict}, {res.options.horizon} actions per episode "
+                 f"(green: proved safe; grey: undecided)", fontsize=10, loc="left")
+    fig.text(0.02, 0.03, f"{res.hazardous:,} of {res.sequences:,} sequences hazardous"
+             + (f"; {res.undecided:,} undecided" if res.undecided else ""), fontsize=8, color="#444444")
+    return D.save_png(fig, path)
+
+
+def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None) -> list[str]:
+    """What ``cellstress verify`` prints: the scope, the proof's size, what each bound cut, the verdict, the
+    hazardous sub-trees and each hazard class with its witness."""
+    o = res.options
+    n_starts = len({s.start for s in res.subtrees})
+    n_phases = len({s.phase for s in res.subtrees})
+    lines = [
+        f"cell      {res.cell.name}  horizon {o.horizon} actions  phases {o.phases} ({len(res.subtrees)} "
+        f"sub-tree{'s' if len(res.subtrees) != 1 else ''}: {n_starts} start point{'s' if n_starts != 1 else ''}, "
+        f"{n_phases} arrival phase{'s' if n_phases != 1 else ''})",
+        f"criterion {criterion_text}",
+        f"decided   {res.sequences - res.undecided:,} of {res.sequences:,} action sequences; {res.states:,} distinct "
+        f"states visited",
+    ]
+    for p in res.pruned:
+        lines.append(f"pruned    {p.bound}: {p.states:,} states, {p.sequences:,} sequences proved safe")
+    scope = (f"within this worker model (30 actions, {o.horizon} per episode), {res.dt:g} s steps, positions merged "
+             f"within {res.merge_xy * 1e6:g} um and angles within {res.merge_angle:g} rad, and this criterion")
+    if res.verdict == PROVED_SAFE:
+        lines.append(f"PROVED-SAFE: no sequence reaches the unsafe set from any start point at any arrival phase "
+                     f"decided ({scope})")
+    elif res.verdict == UNDECIDED:
+        lines.append(f"UNDECIDED: {res.undecided:,} sequences were not decided (time limit); no hazard among the "
+                     f"rest; this is not a proof")
+    else:
+        lines.append(f"UNSAFE: {res.hazardous:,} of {res.sequences:,} sequences hazardous "
+                     f"(p = {res.hazardous / res.sequences:.3e} for a uniformly random worker)")
+    hazardous = [s for s in res.subtrees if s.hazardous]
+    for s in hazardous[:MAX_LISTED]:
+        lines.append(f"  {s.start} at phase {s.phase:g} s: {s.hazardous:,} of {s.sequences:,} hazardous "
+                     f"(p = {s.probability:.3e})")
+    if len(hazardous) > MAX_LISTED:
+        worst = max(hazardous, key=lambda s: s.hazardous)
+        lines.append(f"  ... {len(hazardous) - MAX_LISTED} more hazardous sub-trees (verify.json, verify.html); the "
+                     f"most: {worst.start} at phase {worst.phase:g} s (p = {worst.probability:.3e})")
+    undecided = [s for s in res.subtrees if s.undecided]
+    for s in undecided:
+        lines.append(f"  undecided: {s.start} at phase {s.phase:g} s ({s.undecided:,} sequences)")
+    for i, w in enumerate(res.classes, start=1):
+        k = w.klass
+        failed = "no device saw the worker" if k.device == "none" else f"{k.device} stopped the robot too late"
+        where = f"{out}/{w.file}" if out else w.file
+        x0, y0, x1, y1 = k.approach_cell
+        lines.append(f"class {i:<3} {failed}; {k.robot_link} / {k.body_region}, worker at x {x0:g}..{x1:g}, "
+                     f"y {y0:g}..{y1:g}; {w.sequences:,} sequences; first at "
+                     f"{w.start}, phase {w.phase:g} s: {', '.join(w.actions)}")
+        lines.append(f"          cellstress replay {where}")
+    return lines
+
+
+def verify_page(res: VerifyResult, png: str | Path, path: str | Path, criterion_text: str) -> Path:
+    """``verify.html``: the verdict, the proof's size, the hazard map, the hazardous sub-trees and each hazard
+    class with its witness (self-contained, like every report page)."""
+    lines = summary_lines(res, criterion_text)
+    verdict = next(ln for ln in lines if ln.startswith(res.verdict))
+    body = [f"<h1>{escape(res.cell.name)}: {escape(res.verdict)}</h1>",
+            f'<div class="verdict {"safe" if res.verdict == PROVED_SAFE else "hazard"}">{escape(verdict)}</div>',
+            H.table(None, [[ln.split(" ", 1)[0], ln.split(" ", 1)[1].strip()] for ln in lines[:3 + len(res.pruned)]]),
+            H.figure(png, "Hazard map: arrival phases x start points", "hazard map"),
+            "<h2>Sub-trees</h2>",
+            H.table(["start", "phase [s]", "verdict", "hazardous", "of", "P(hazard)", "undecided", "states"],
+                    [[s.start, f"{s.phase:g}", s.verdict, f"{s.hazardous:,}", f"{s.sequences:,}",
+                      f"{s.probability:.3e}", f"{s.undecided:,}", f"{sum(s.states):,}"] for s in res.subtrees
+                     if s.verdict != PROVED_SAFE] or [["(every sub-tree proved safe)", "", "", "", "", "", "", ""]],
+                    numeric={1, 3, 4, 5, 6, 7})]
+    if res.classes:
+        body += ["<h2>Hazard classes and their witnesses</h2>",
+                 H.table(["class", "device", "robot link / body region", "sequences", "witness", "file"],
+                         [[i, w.klass.device, f"{w.klass.robot_link} / {w.klass.body_region}", f"{w.sequences:,}",
+                           ", ".join(w.actions), w.file] for i, w in enumerate(res.classes, start=1)],
+                         numeric={0, 3})]
+    return H.write_page(path, H.page(f"verify {res.cell.name}", body,
+                                     f"cellstress {res.version}; replay a witness with: cellstress replay FILE"))

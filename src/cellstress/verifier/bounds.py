@@ -1,0 +1,53 @@
+"""Sound pruning bounds: a sub-tree is cut only when no completion of it can reach the unsafe set.
+
+Each bound takes a layer's children (states after an action, and the metric row of each one's last step) and
+says which of the living ones are safe for every completion of ``r`` more actions. docs/verify.md gives each
+soundness argument; ``tests/verify/test_bounds.py`` checks the assumptions they rest on over many random steps.
+
+* ``at-rest``: a latched stop has taken full effect: the robot stands for good, and the criterion's kernel test
+  needs it to move.
+* ``distance``: the worker cannot come within the criterion's contact distance of anything the robot can occupy
+  in the time left (``verifier.reach``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+
+from cellstress.sim import layout as L
+from cellstress.verifier.reach import SweptField
+
+AT_REST = "at-rest"
+DISTANCE = "distance"
+BOUND_NAMES = (AT_REST, DISTANCE)
+
+
+class Bounds:
+    """The bounds that hold for one simulator (its criterion and robot); ``enabled``: the names to use."""
+
+    def __init__(self, sim, enabled: tuple[str, ...] = BOUND_NAMES, horizon: int = 8):
+        scal = sim.params.scal
+        self.dt = float(scal[L.C_DT])
+        self.stop_time = float(scal[L.C_STOP_TIME])
+        self.spa = sim.params.spa
+        vtol = float(scal[L.C_VTOL])
+        # The kernel test is d_HR <= DTOL and v_R > VTOL; a robot at rest has v_R == 0 exactly (see docs), so it is
+        # never unsafe when VTOL >= 0. A criterion that judges contacts itself (VTOL inf: no kernel test) may call
+        # a contact with a standing robot unsafe (ISO/TS 15066 clamping), so the bound does not apply to it.
+        self.at_rest = AT_REST in enabled and sim.contacts is None and 0.0 <= vtol < np.inf
+        # Every criterion judges contacts only (d_HR at most its distance tolerance, the kernel's DTOL; a criterion
+        # without a kernel test is shown only the rows within it, Simulator.first_unsafe): the distance bound holds
+        # for all of them.
+        self.swept = SweptField(sim, horizon) if DISTANCE in enabled else None
+
+    def prune(self, children: np.ndarray, last: np.ndarray, alive: np.ndarray, left: int
+              ) -> Iterator[tuple[str, np.ndarray]]:
+        """(bound name, mask of living children it proves safe for all ``left`` more actions), in order."""
+        t = children[:, L.S_K] * self.dt
+        if self.at_rest:
+            # the kernel's own test of a completed stop (path_time): t - t_stop >= T, in the same float arithmetic
+            yield AT_REST, alive & (t - children[:, L.S_TSTOP] >= self.stop_time)
+        if self.swept is not None:
+            yield DISTANCE, alive & self.swept.safe(children, left * self.spa)

@@ -1,0 +1,227 @@
+"""A verification: every (start point, arrival phase) decided, in worker processes if asked, and assembled into
+one ``VerifyResult`` in a fixed order (start points as the cell lists them, phases ascending), so the result
+does not depend on the number of workers or on which finished first."""
+
+from __future__ import annotations
+
+import multiprocessing
+import time
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from pydantic import ValidationError
+
+from cellstress.cell.load import Cell
+from cellstress.core.errors import CellstressError
+from cellstress.core.version import __version__
+from cellstress.human.actions import N_ACTIONS
+from cellstress.searchers.distinct import hazard_class, hazard_class_record, root_cause
+from cellstress.searchers.result import CellRef
+from cellstress.sim.layout import M_STEP, M_T
+from cellstress.sim.simulator import Simulator
+from cellstress.verifier.bounds import Bounds
+from cellstress.verifier.phases import StartPoint, arrival_phases, start_points
+from cellstress.verifier.records import (
+    PROVED_SAFE,
+    UNDECIDED,
+    UNSAFE,
+    ClassCount,
+    Pruned,
+    Subtree,
+    VerifyOptions,
+    VerifyResult,
+    Witness,
+)
+from cellstress.verifier.tree import QUANT_ANGLE, QUANT_XY, decide
+from cellstress.verifier.witness import witness_actions, write_witness
+
+WITNESS_DIR = "witness-{:02d}"
+
+
+class VerifyError(CellstressError):
+    """A bad option of a verification (a user error: exit code 2)."""
+
+
+@dataclass(frozen=True)
+class Task:
+    """One sub-tree to decide: the cell, a start point, an arrival phase."""
+
+    cell: Cell
+    start: StartPoint
+    phase: float
+    options: VerifyOptions
+    deadline: float | None  # time.time() after which it is left undecided
+
+
+@dataclass(frozen=True)
+class Found:
+    """A hazard class as one sub-tree found it: its first hit and the sequences of the class there."""
+
+    key: tuple
+    actions: tuple[int, ...]
+    step: int
+    time_s: float
+    sequences: int
+
+
+@dataclass(frozen=True)
+class Decided:
+    subtree: Subtree
+    found: tuple[Found, ...]
+
+
+# A per-process cache of the cell's simulator, keyed by the cell's hash and criterion: a worker builds the layout
+# (robot, reach field) once for all its sub-trees. A Simulator's results never depend on what it ran before.
+_SIMS: dict[tuple[str, str], Simulator] = {}
+
+
+def _simulator(cell: Cell) -> Simulator:
+    key = (cell.sha256, cell.spec.criterion.type)
+    sim = _SIMS.get(key)
+    if sim is None:
+        sim = _SIMS[key] = Simulator(cell)
+    return sim
+
+
+def decide_task(task: Task, progress: Callable[[int], None] | None = None) -> Decided:
+    """Decide one sub-tree (runs in a worker process)."""
+    opts = task.options
+    if task.deadline is not None and time.time() > task.deadline:  # not begun: all of it undecided
+        total = N_ACTIONS ** opts.horizon
+        return Decided(Subtree(start=task.start.name, phase=task.phase, verdict=UNDECIDED, sequences=total,
+                               hazardous=0, undecided=total, probability=0.0, states=(), expanded=0, pruned=(),
+                               classes=()), ())
+    sim = _simulator(task.cell).with_start(task.start.pose, task.phase)
+    deadline = None if task.deadline is None else time.monotonic() + (task.deadline - time.time())
+    out = decide(sim, opts.horizon, Bounds(sim, opts.bounds, opts.horizon), deadline=deadline, progress=progress)
+    found: dict[tuple, list] = {}
+    for hit in out.hits:
+        key = hazard_class(sim, hit.state, hit.row)
+        if key in found:
+            found[key][4] += hit.sequences
+        else:
+            found[key] = [key, hit.actions, int(hit.row[M_STEP]), round(float(hit.row[M_T]), 9), hit.sequences]
+    verdict = UNSAFE if out.hazardous else UNDECIDED if out.undecided else PROVED_SAFE
+    sub = Subtree(start=task.start.name, phase=task.phase, verdict=verdict, sequences=out.total,
+                  hazardous=out.hazardous, undecided=out.undecided, probability=out.hazardous / out.total,
+                  states=tuple(out.states), expanded=out.expanded,
+                  pruned=tuple(Pruned(bound=b, states=out.pruned_states[b], sequences=out.pruned_sequences[b])
+                               for b in opts.bounds if b in out.pruned_states),
+                  classes=())
+    return Decided(sub, tuple(Found(*f) for f in found.values()))
+
+
+def _init_worker() -> None:
+    import signal
+
+    import numba
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the main process handles Ctrl-C and stops the pool
+    numba.set_num_threads(1)  # one thread per worker process: N workers on N cores
+
+
+def tasks_of(sim: Simulator, options: VerifyOptions, deadline: float | None) -> list[Task]:
+    """The sub-trees of a verification, in the order of the result."""
+    return [Task(sim.cell, s, p, options, deadline) for s in start_points(sim.cell)
+            for p in arrival_phases(sim, s, options.phases)]
+
+
+def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out: str | Path | None = None,
+               progress: Callable[[int, int], None] | None = None) -> VerifyResult:
+    """Decide ``sim``'s cell (see ``cellstress.api.verify``). ``progress(sequences decided, of)``; ``out``: a folder
+    for ``verify.json`` and one witness per hazard class (``witness-NN/result.json``)."""
+    cell = sim.cell
+    _SIMS[(cell.sha256, cell.spec.criterion.type)] = sim
+    deadline = None if options.time_limit is None else time.time() + options.time_limit
+    tasks = tasks_of(sim, options, deadline)
+    total = len(tasks) * N_ACTIONS ** options.horizon
+    done = [0]
+
+    def tick(n: int) -> None:
+        done[0] += n
+        if progress is not None:
+            progress(done[0], total)
+
+    if workers <= 1 or len(tasks) == 1:
+        decided = [decide_task(t, tick) for t in tasks]
+    else:
+        # spawned, not forked: numba's thread pool in this process makes a fork unsafe
+        with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                                 initializer=_init_worker) as pool:
+            futures = [pool.submit(decide_task, t) for t in tasks]
+            for f in futures:
+                f.add_done_callback(lambda f: tick(f.result().subtree.sequences) if not f.exception() else None)
+            decided = [f.result() for f in futures]
+    return assemble(sim, options, tasks, decided, out)
+
+
+def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided: list[Decided],
+             out: str | Path | None) -> VerifyResult:
+    """The result of the decided sub-trees: hazard classes numbered in the order first found, their witnesses
+    written (if ``out``)."""
+    cell = sim.cell
+    classes: dict[tuple, dict[str, Any]] = {}
+    subtrees = []
+    for task, d in zip(tasks, decided, strict=True):
+        counts = []
+        for f in d.found:
+            c = classes.get(f.key)
+            if c is None:
+                c = classes[f.key] = {"index": len(classes), "task": task, "found": f, "sequences": 0}
+            c["sequences"] += f.sequences
+            counts.append(ClassCount(klass=c["index"], sequences=f.sequences))
+        subtrees.append(d.subtree.model_copy(update={"classes": tuple(counts)}))
+    witnesses = []
+    for c in classes.values():
+        task, f = c["task"], c["found"]
+        rel = f"{WITNESS_DIR.format(c['index'] + 1)}/result.json"
+        actions = witness_actions(cell, task.start, task.phase, f.actions)
+        if out is not None:
+            write_witness(sim, actions, Path(out) / WITNESS_DIR.format(c["index"] + 1))
+        klass = hazard_class_record(f.key)
+        witnesses.append(Witness.model_construct(
+            klass=klass, root_cause=root_cause(klass), start=task.start.name, phase=task.phase,
+            actions=actions, step=f.step, time_s=f.time_s, sequences=c["sequences"], file=rel))
+    hazardous = sum(s.hazardous for s in subtrees)
+    undecided = sum(s.undecided for s in subtrees)
+    pruned: dict[str, list[int]] = {}
+    for s in subtrees:
+        for p in s.pruned:
+            acc = pruned.setdefault(p.bound, [0, 0])
+            acc[0] += p.states
+            acc[1] += p.sequences
+    source = cell.source if cell.directory is None else str(Path(cell.source).expanduser().resolve())
+    result = VerifyResult(
+        cell=CellRef(name=cell.name, sha256=cell.sha256, source=source, criterion=cell.spec.criterion.type),
+        options=options, dt=sim.dt, cycle=float(sim.layout.trajectory.cycle), merge_xy=QUANT_XY,
+        merge_angle=QUANT_ANGLE, verdict=UNSAFE if hazardous else UNDECIDED if undecided else PROVED_SAFE,
+        sequences=sum(s.sequences for s in subtrees), hazardous=hazardous, undecided=undecided,
+        states=sum(sum(s.states) for s in subtrees),
+        pruned=tuple(Pruned(bound=b, states=v[0], sequences=v[1]) for b, v in pruned.items()),
+        subtrees=tuple(subtrees), classes=tuple(witnesses), version=__version__)
+    if out is not None:
+        result.write(out)
+    return result
+
+
+
+def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "all", time_limit: float | None = None,
+                bounds: tuple[str, ...] | None = None, workers: int = 1, out: str | Path | None = None,
+                progress: Callable[[int, int], None] | None = None) -> VerifyResult:
+    """``run_verify`` with its options checked: VerifyError (a user error) for a bad one."""
+    fields: dict[str, Any] = {"horizon": sim.actions_per_episode if horizon is None else horizon, "phases": phases}
+    if time_limit is not None:
+        fields["time_limit"] = time_limit
+    if bounds is not None:
+        fields["bounds"] = tuple(bounds)
+    try:
+        options = VerifyOptions.model_validate(fields, strict=False)
+    except ValidationError as exc:
+        e = exc.errors(include_url=False)[0]
+        raise VerifyError(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}") from None
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise VerifyError(f"workers must be a whole number >= 1, not {workers!r}")
+    return run_verify(sim, options, workers=workers, out=out, progress=progress)

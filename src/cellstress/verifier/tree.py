@@ -1,0 +1,230 @@
+"""One start point at one arrival phase, decided: every sequence of the worker's actions, layer by layer, with
+identical simulator states merged and sub-trees cut only where a sound bound proves them safe.
+
+**Layers.** Layer n holds the distinct states after n actions that are not unsafe and not proved safe. Every
+state carries how many action prefixes reach it (its multiplicity, an exact integer) and one of them, the
+lexicographically smallest (its witness prefix): the states of a layer are kept in that order, so the children
+of state i by action a, numbered i * 30 + a, come in the order of their prefixes too, and the first child
+that falls on a merged state is the one whose prefix is the smallest.
+
+**Merging.** Two states merge when their future is the same: the same time step and actions played (true of a
+whole layer), positions equal to within ``QUANT_XY`` (1 um), heading (modulo a full turn), forward and lateral
+flexion equal to within ``QUANT_ANGLE`` (1e-9 rad), the latched stop time ``TSTOP`` bit for bit and the same
+triggering device. The rest of the state does not reach the future: the first detection time ``TRIG_T`` is
+written by ``sense_and_measure`` and read by nothing; ``TRIG_DEV`` is only compared with -1 to decide whether
+to write ``TRIG_T``; neither enters the worker's motion, the robot (``robot_at`` reads the step and ``TSTOP``)
+or the unsafe test. ``TRIG_DEV`` is kept in the key all the same, because it names the device of a hazard's
+class (``searchers.distinct``): merging it away could hide a class. The merged state is the witness prefix's own
+state, bit for bit, so every witness is a sequence the simulator really plays.
+
+**Counting.** A child that is unsafe ends its episode: all 30^r completions of its prefix are hazardous
+(r actions left), times its parent's multiplicity. A child proved safe by a bound (``verifier.bounds``) counts its
+completions as safe. A leaf that is neither is safe. Every count is a Python int; hazardous + safe = 30^N
+exactly when the tree is decided, and what a time limit leaves is reported as undecided.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cellstress.human.actions import N_ACTIONS
+from cellstress.sim import layout as L
+from cellstress.sim.kernels.expand import expand_states
+from cellstress.verifier.bounds import Bounds
+
+QUANT_XY = 1e-6  # m: positions this close merge
+QUANT_ANGLE = 1e-9  # rad: headings and flexions this close merge
+CHUNK = 8192  # parents per compiled expansion (bounds memory; the time limit and progress are checked between)
+TWO_PI = 2.0 * math.pi
+
+
+@dataclass(frozen=True)
+class Hit:
+    """An unsafe child: its action prefix, its state and the metric row of its unsafe step; ``sequences``: the
+    hazardous sequences it stands for (its parent's multiplicity times 30^(actions left))."""
+
+    actions: tuple[int, ...]
+    state: np.ndarray
+    row: np.ndarray
+    sequences: int
+
+
+@dataclass
+class TreeOutcome:
+    """What deciding one tree found: exact counts, states per layer, what each bound cut, the unsafe children."""
+
+    horizon: int
+    total: int
+    hazardous: int = 0
+    safe: int = 0
+    states: list[int] = field(default_factory=list)
+    expanded: int = 0
+    pruned_states: dict[str, int] = field(default_factory=dict)
+    pruned_sequences: dict[str, int] = field(default_factory=dict)
+    hits: list[Hit] = field(default_factory=list)
+    timed_out: bool = False
+    layers: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)  # (sorted keys, states), if kept
+
+    @property
+    def undecided(self) -> int:
+        return self.total - self.hazardous - self.safe
+
+    @property
+    def decided(self) -> bool:
+        return self.undecided == 0
+
+
+def merge_keys(states: np.ndarray) -> np.ndarray:
+    """One fixed-size byte key per state (rows of ``states``): equal keys, equal futures (see the module)."""
+    key = np.empty((len(states), 6), dtype=np.int64)
+    key[:, 0] = np.rint(states[:, L.S_X] / QUANT_XY)
+    key[:, 1] = np.rint(states[:, L.S_Y] / QUANT_XY)
+    key[:, 2] = np.rint(np.mod(states[:, L.S_HEADING], TWO_PI) / QUANT_ANGLE)
+    key[:, 3] = np.rint(states[:, L.S_FWD] / QUANT_ANGLE)
+    key[:, 4] = np.rint(states[:, L.S_LAT] / QUANT_ANGLE)
+    key[:, 5] = states[:, L.S_TSTOP].view(np.int64) * 8 + (states[:, L.S_TRIG_DEV].astype(np.int64) + 1)
+    return np.ascontiguousarray(key).view(np.dtype((np.void, key.dtype.itemsize * key.shape[1]))).ravel()
+
+
+class _Judge:
+    """For a criterion without a kernel test: children whose action came within the contact distance are
+    stepped again by ``Simulator.step``, which hands each contact to the criterion and ends the episode where it
+    says so (contacts are rare, so this costs little)."""
+
+    def __init__(self, sim):
+        self.sim = sim
+        self.active = sim.contacts is not None
+        self.dtol = sim.criterion.distance_tolerance
+
+    def __call__(self, parents, children, last, d_min, n_act):
+        if not self.active:
+            return
+        for c in np.flatnonzero(d_min <= self.dtol):
+            nxt, rows = self.sim.step(parents[c // n_act], int(c % n_act))
+            children[c] = nxt
+            last[c] = rows[-1]
+
+
+def decide(sim, horizon: int, bounds: Bounds, *, deadline: float | None = None,
+           progress: Callable[[int], None] | None = None, keep: bool = False) -> TreeOutcome:
+    """Decide every sequence of ``horizon`` actions from ``sim``'s start (see the module). ``deadline``: a
+    ``time.monotonic()`` after which the tree is left undecided; ``progress(sequences)`` is told how many more
+    sequences each step decided; ``keep``: keep every layer's merged states, for ``lookup``."""
+    n_act = N_ACTIONS
+    out = TreeOutcome(horizon, n_act ** horizon)
+    judge = _Judge(sim)
+    s0 = sim.reset()
+    out.states.append(1)
+    if s0[L.S_UNSAFE] != 0.0:  # unsafe where it starts: every sequence is hazardous
+        out.hazardous = out.total
+        out.hits.append(Hit((), s0, sim.initial_metrics(), out.total))
+        _tell(progress, out.total)
+        return out
+    # multiplicities are at most 30^N: int64 while that fits, Python ints beyond
+    exact = np.int64 if out.total < 2 ** 62 else object
+    states, mult, prefixes = s0[None, :].copy(), np.ones(1, dtype=exact), np.zeros((1, 0), dtype=np.int8)
+    for depth in range(1, horizon + 1):
+        weight = n_act ** (horizon - depth)
+        kept_states, kept_mult, kept_parent, kept_action = [], [], [], []
+        for i0 in range(0, len(states), CHUNK):
+            if deadline is not None and time.monotonic() > deadline:
+                out.timed_out = True
+                return out
+            parents = states[i0:i0 + CHUNK]
+            n_child = len(parents) * n_act
+            children = np.empty((n_child, L.NS))
+            last = np.empty((n_child, L.NM))
+            d_min = np.empty(n_child)
+            expand_states(sim.params, parents, n_act, children, last, d_min)
+            judge(parents, children, last, d_min, n_act)
+            out.expanded += n_child
+            cmult = np.repeat(mult[i0:i0 + CHUNK], n_act)
+            unsafe = children[:, L.S_UNSAFE] != 0.0
+            before = out.hazardous + out.safe
+            for c in np.flatnonzero(unsafe):
+                seqs = int(cmult[c]) * weight
+                out.hazardous += seqs
+                acts = (*prefixes[i0 + c // n_act].tolist(), int(c % n_act))
+                out.hits.append(Hit(tuple(acts), children[c].copy(), last[c].copy(), seqs))
+            alive = ~unsafe
+            if depth == horizon:
+                out.safe += int(cmult[alive].sum())
+            else:
+                for name, cut in bounds.prune(children, last, alive, horizon - depth):
+                    n_cut = int(np.count_nonzero(cut))
+                    if n_cut:
+                        seqs = int(cmult[cut].sum()) * weight
+                        out.safe += seqs
+                        out.pruned_states[name] = out.pruned_states.get(name, 0) + n_cut
+                        out.pruned_sequences[name] = out.pruned_sequences.get(name, 0) + seqs
+                        alive &= ~cut
+                idx = np.flatnonzero(alive)
+                kept_states.append(children[idx])
+                kept_mult.append(cmult[idx])
+                kept_parent.append(i0 + idx // n_act)
+                kept_action.append((idx % n_act).astype(np.int8))
+            _tell(progress, out.hazardous + out.safe - before)
+        if depth == horizon:
+            break
+        states, mult, prefixes = _merge(np.concatenate(kept_states), np.concatenate(kept_mult),
+                                        np.concatenate(kept_parent), np.concatenate(kept_action), prefixes)
+        out.states.append(len(states))
+        if keep:
+            keys = merge_keys(states)
+            order = np.argsort(keys)
+            out.layers.append((keys[order], states[order]))
+        if not len(states):
+            break
+    return out
+
+
+def lookup(sim, out: TreeOutcome, bounds: Bounds, actions) -> str:
+    """How a kept tree (``decide(..., keep=True)``) counted the sequence ``actions``: ``hazardous``, ``safe`` or
+    ``pruned:BOUND``. It follows the sequence through the merged states, as the counting did: the state after
+    each action is the merged state its key falls on."""
+    state = sim.reset()
+    if state[L.S_UNSAFE] != 0.0:
+        return "hazardous"
+    for depth, a in enumerate(actions, start=1):
+        child, rows = sim.step(state, a)
+        if child[L.S_UNSAFE] != 0.0:
+            return "hazardous"
+        if depth == out.horizon:
+            return "safe"
+        alive = np.ones(1, dtype=bool)
+        for name, cut in bounds.prune(child[None, :], rows[-1:], alive, out.horizon - depth):
+            if cut[0]:
+                return f"pruned:{name}"
+        keys, states = out.layers[depth - 1]
+        i = int(np.searchsorted(keys, merge_keys(child[None, :])[0]))
+        if i >= len(keys) or keys[i] != merge_keys(child[None, :])[0]:
+            raise KeyError(f"the state after {list(actions[:depth])} is in no merged state of layer {depth}")
+        state = states[i]
+    return "safe"
+
+
+def _merge(children, cmult, parent, action, prefixes):
+    """The distinct states among ``children`` (in prefix order), their summed multiplicities and witness
+    prefixes."""
+    if not len(children):
+        return children, cmult, np.zeros((0, prefixes.shape[1] + 1), dtype=np.int8)
+    keys = merge_keys(children)
+    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")  # distinct states in the order of their first (smallest) prefix
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    mult = np.zeros(len(first), dtype=cmult.dtype)
+    np.add.at(mult, rank[inverse.ravel()], cmult)
+    reps = first[order]
+    new_prefixes = np.concatenate([prefixes[parent[reps]], action[reps, None]], axis=1)
+    return children[reps], mult, new_prefixes
+
+
+def _tell(progress, n: int) -> None:
+    if progress is not None and n:
+        progress(n)

@@ -1,0 +1,92 @@
+"""What the pruning bounds rest on, checked over many random steps (docs/verify.md gives the arguments): the
+worker within its radius of the hip pivot, the pivot moving at most a stride a step, the robot's capsule axes
+no faster than the speed bound, the distance bound never above a d_HR the simulator measures later, and a robot
+at rest never moving again."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cellstress.sim import layout as L
+from cellstress.sim.scene import robot_capsules
+from cellstress.sim.simulator import Simulator
+from cellstress.verifier.bounds import Bounds
+from cellstress.verifier.reach import SweptField, robot_point_speed, worker_radius
+
+CELLS = ["baseline", "s1-scanner-width", "s3-fence-gap"]
+
+
+@pytest.mark.parametrize("cell", CELLS)
+def test_worker_within_its_radius_and_a_stride(cell) -> None:
+    sim = Simulator(cell)
+    P = sim.params
+    rng = np.random.default_rng(1)
+    paths = sim.worker_paths(rng.integers(0, 30, size=(200, 8))).reshape(-1, 5)
+    stride = P.body[L.B_WALK_SPEED] * sim.dt
+    steps = np.hypot(*np.diff(paths.reshape(200, -1, 5)[:, :, :2], axis=1).transpose(2, 0, 1))
+    assert steps.max() <= stride * (1 + 1e-12)
+    radius = worker_radius(P.body, float(P.scal[L.C_REACH_H]))
+    poses = paths[rng.choice(len(paths), 400, replace=False)]
+    hip = np.column_stack([poses[:, :2], np.full(len(poses), P.body[L.B_HIP_Z])])
+    points = hip[:, None, :] + rng.uniform(-2.5, 2.5, size=(len(poses), 64, 3))
+    d = sim.worker_distances(poses, points)
+    assert np.all(d >= np.linalg.norm(points - hip[:, None, :], axis=2) - radius)
+
+
+@pytest.mark.parametrize("cell", CELLS)
+def test_robot_no_faster_than_its_speed_bound(cell) -> None:
+    sim = Simulator(cell)
+    speed = robot_point_speed(sim.layout)
+    h = 1e-3
+    taus = np.arange(0.0, sim.layout.trajectory.cycle, h)
+    poses = [robot_capsules(sim.layout, t) for t in taus]
+    a = np.stack([p[0] for p in poses])
+    b = np.stack([p[1] for p in poses])
+    moved = np.maximum(np.linalg.norm(np.diff(a, axis=0), axis=2), np.linalg.norm(np.diff(b, axis=0), axis=2))
+    assert moved.max() <= speed * h
+    assert moved.max() > 0.2 * speed * h  # and not a uselessly loose bound
+
+
+@pytest.mark.parametrize("cell", CELLS)
+def test_distance_bound_never_above_a_later_d_hr(cell) -> None:
+    base = Simulator(cell)
+    rng = np.random.default_rng(2)
+    phases = rng.choice(np.arange(0.0, base.layout.trajectory.cycle, 0.05), 4, replace=False)
+    for phase in phases:
+        sim = base.with_start(base.start, float(phase))
+        field = SweptField(sim, 8)
+        spa = sim.steps_per_action
+        for acts in rng.integers(0, 30, size=(60, 8)):
+            rows = sim.run(acts).rows
+            for layer in range(1, 8):
+                k = layer * spa
+                if k >= len(rows) - 1 or rows[k, L.M_PHASE] >= L.PHASE_BRAKING:
+                    break
+                later = rows[k + 1:]
+                # the bound over the next j steps holds at the j-th
+                for j in sorted({1, min(spa, len(later)), len(later) // 2, len(later)} - {0}):
+                    lb = field.lower_bound(k, j, rows[k:k + 1, L.M_X], rows[k:k + 1, L.M_Y])[0]
+                    assert later[j - 1, L.M_D] >= lb - field.radius
+
+
+def test_a_robot_at_rest_stays_at_rest() -> None:
+    sim = Simulator("baseline")  # its devices stop the robot when the worker walks in
+    bounds = Bounds(sim, horizon=8)
+    rng = np.random.default_rng(3)
+    rested = 0
+    for acts in rng.integers(0, 6, size=(150, 8)):  # walking (with any posture), into the cell
+        rows = sim.run(acts).rows
+        t_stop = np.inf
+        state = sim.reset()
+        for a in acts:
+            state, _ = sim.step(state, int(a))
+            if sim.is_unsafe(state):
+                break
+            t_stop = state[L.S_TSTOP]
+            if state[L.S_K] * sim.dt - t_stop >= bounds.stop_time:
+                later = rows[int(state[L.S_K]) + 1:]
+                assert np.all(later[:, L.M_V] == 0.0) and not later[:, L.M_UNSAFE].any()
+                rested += 1
+                break
+    assert rested > 20
