@@ -60,7 +60,7 @@ def test_witnesses_are_played_bit_exactly() -> None:
 
 def test_searchers_hazards_are_in_the_hazardous_set() -> None:
     # every hazardous episode of a whole search budget, at the cell's horizon of 8 actions
-    found = cellstress.search("s1-scanner-width", "plan", budget=200, seed=0, until="budget")
+    found = cellstress.search("s1-scanner-width", "plan", budget=100, seed=0, until="budget")
     assert len(found.hazards) > 10
     sim = Simulator("s1-scanner-width")
     bounds = Bounds(sim, horizon=8)
