@@ -61,6 +61,7 @@ CELL_COMMANDS = {
     "show": ("show", CELL, "--out", "out/cell.png"),
     "campaign": ("campaign", "--cells", CELL, "--searchers", "random", "--seeds", "1", "--budget", "2",
                  "--workers", "1", "--out", "out"),
+    "verify": ("verify", CELL, "--horizon", "1", "--phases", "cell", "--workers", "1", "--out", "out"),
 }
 
 
