@@ -21,6 +21,8 @@ from pydantic import (
     model_validator,
 )
 
+from cellstress.cell.arrival import MAX_CYCLE, ArrivalField, ArrivalWindow  # noqa: F401  (part of the schema)
+from cellstress.cell.obstacles import BoxFootprint, ObstacleSpec  # noqa: F401  (part of the schema)
 from cellstress.core import registry
 from cellstress.core.fields import (
     MAX_EXTENT,
@@ -29,7 +31,6 @@ from cellstress.core.fields import (
     Coordinate,
     Elevation,
     Height,
-    Length,
     Name,
     Point2,
     Point3,
@@ -45,7 +46,6 @@ MAX_WAYPOINTS = 256
 MAX_PANELS = 1024  # fence panels in a cell: the simulator checks the near ones at every step
 MAX_COUNT = 32  # devices, start points, table polygons
 MAX_CAPSULES = 64
-MAX_CYCLE = 600.0  # s, the robot's cycle (the static check samples it every 10 ms)
 
 JointAngle = Annotated[float, Field(ge=-3600.0, le=3600.0, allow_inf_nan=False)]  # then the URDF's limits
 
@@ -226,47 +226,6 @@ class TableSpec(Record):
     """Outlines of the table top [m], each a simple polygon of at most 256 points."""
 
 
-class BoxFootprint(Record):
-    """A rectangle on the floor."""
-
-    center: Point2
-    """Centre [m]."""
-    size: tuple[Length, Length]
-    """Length along its own x axis and width [m]."""
-    yaw_deg: Angle = 0.0
-    """Rotation about the vertical axis [deg], counter-clockwise seen from above."""
-
-    def corners(self) -> tuple[Point2, ...]:
-        c, s = math.cos(math.radians(self.yaw_deg)), math.sin(math.radians(self.yaw_deg))
-        hx, hy = self.size[0] / 2.0, self.size[1] / 2.0
-        return tuple((self.center[0] + c * u - s * v, self.center[1] + s * u + c * v)
-                     for u, v in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)))
-
-
-class ObstacleSpec(Record):
-    """A static solid standing on the floor (a conveyor, a pallet, a machine, a pedestal): a footprint raised to
-    a height. The worker cannot walk into it and cannot lean the trunk or head into it."""
-
-    name: Name
-    """Its name in outputs and pictures."""
-    polygon: Polygon | None = None
-    """Its footprint [m], a simple polygon; give this or ``box``."""
-    box: BoxFootprint | None = None
-    """Its footprint as a rectangle; give this or ``polygon``."""
-    height: Height
-    """Height of its top above the floor [m]."""
-
-    @model_validator(mode="after")
-    def _one_footprint(self) -> ObstacleSpec:
-        if (self.polygon is None) == (self.box is None):
-            raise ValueError("give exactly one of polygon and box")
-        return self
-
-    def footprint(self) -> tuple[Point2, ...]:
-        """The footprint's corners [m]."""
-        return self.polygon if self.polygon is not None else self.box.corners()
-
-
 class FenceSpec(Record):
     """A run of fence panels along a polyline, from ``bottom`` to ``top`` above the floor."""
 
@@ -358,32 +317,6 @@ class NamedStart(StartSpec):
     """The start point's name (letters, digits, ``. _ -``): an episode's actions begin with ``start:NAME``."""
     phase: Annotated[float, Field(ge=0.0, le=3600.0, allow_inf_nan=False)] | None = None
     """The robot's time in its cycle [s] when a worker from here arrives; absent: robot.task.phase."""
-
-
-class ArrivalWindow(Record):
-    """A window of the robot's cycle in which the worker may arrive."""
-
-    start: Annotated[float, Field(ge=0.0, le=MAX_CYCLE, allow_inf_nan=False)]
-    """Earliest arrival: the robot's time in its cycle [s]."""
-    end: Annotated[float, Field(ge=0.0, le=MAX_CYCLE, allow_inf_nan=False)]
-    """Latest arrival [s], at least ``start``; past the cycle's end it wraps around to its beginning."""
-
-    @model_validator(mode="after")
-    def _ordered(self) -> ArrivalWindow:
-        if self.end < self.start:
-            raise ValueError(f"end ({self.end}) must not be before start ({self.start})")
-        return self
-
-
-def _arrival_kind(v: object) -> str:
-    return "arrival-word" if isinstance(v, str) else "arrival-window"
-
-
-# "cycle", "fixed" or a window; the discriminator keeps pydantic from reporting both union branches.
-ArrivalField = Annotated[
-    Annotated[Literal["cycle", "fixed"], Tag("arrival-word")] | Annotated[ArrivalWindow, Tag("arrival-window")],
-    Discriminator(_arrival_kind),
-]
 
 
 class HumanSpec(Record):
