@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from cellstress.cell.load import Cell, load_cell
+from cellstress.core.errors import CellError
 from cellstress.core.records import Measures
 from cellstress.human.actions import ACTION_NAMES, N_ACTIONS, action_index
 from cellstress.human.body import BODY_PARTS
@@ -134,6 +135,10 @@ class Simulator:
         self.criterion = cell.spec.criterion
         # a criterion without a kernel fast path judges the contacts here (sim.contacts)
         self.contacts = None if self.criterion.kernel_test() is not None else ContactModel(self.layout)
+        if self.contacts is not None and not self.layout.stops_latch:
+            # _state_at replays the plain stop latch only; the restart and warning slots are not replayed yet
+            raise CellError(cell.source, "criterion", "a criterion that judges contacts (no kernel test) is not "
+                            "supported yet with automatic restarts or warning fields")
         self._worker_w = None
         self._lookahead: dict[tuple[float | None, float], Lookahead] = {}
 
