@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Literal
 
 from cellstress.core.fields import Name, PositiveTime, Record
-from cellstress.core.records import Channel
+from cellstress.core.records import Channel, IsoDistance
 
 
 class AutomaticRestart(Record):
@@ -41,3 +41,7 @@ class DeviceRecord(Record):
         """What the kernel senses for this device: each detection primitive with its effect. By default every
         primitive stops the robot; a kind with a warning field adds one that reduces its speed."""
         return tuple(Channel(p, self.name, 0.0, self.response_time, self.clear_time) for p in self.primitives())
+
+    def warning_distance(self, stopping_time: float) -> IsoDistance | None:
+        """ISO 13855 distance of the device's warning field (a channel that reduces the speed), if it has one."""
+        return None
