@@ -3,7 +3,9 @@ the record conventions of cell files."""
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
+
+from pydantic import Discriminator, Tag
 
 from cellstress.core.fields import Name, PositiveTime, Record
 from cellstress.core.records import Channel, IsoDistance
@@ -16,7 +18,13 @@ class AutomaticRestart(Record):
     """Clear time [s]: how long the device must not see the worker before the robot restarts."""
 
 
-Restart = Literal["manual"] | AutomaticRestart
+def _restart_kind(v) -> str:
+    return "manual" if isinstance(v, str) else "automatic"
+
+
+# a tagged union, so that a wrong value gets the one message of the form it tried (a word or a mapping)
+Restart = Annotated[Annotated[Literal["manual"], Tag("manual")] | Annotated[AutomaticRestart, Tag("automatic")],
+                    Discriminator(_restart_kind)]
 
 
 class DeviceRecord(Record):
