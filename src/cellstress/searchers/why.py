@@ -39,7 +39,8 @@ def safeguard_words(layout, records, unsafe_row: int) -> str | None:
             if name in stop_names:
                 last_stop_seen = (name, r.t)
         if prev is not None and prev.stop_phase in _STOPPING and r.stop_phase not in _STOPPING:
-            who = "" if last_stop_seen is None else f"{last_stop_seen[0]} last saw the worker at {last_stop_seen[1]:.2f} s; "
+            who = "" if last_stop_seen is None else \
+                f"{last_stop_seen[0]} last saw the worker at {last_stop_seen[1]:.2f} s; "
             unseen = "while no device saw the worker" if not r.devices else f"while {', '.join(r.devices)} saw them"
             parts.append(f"{who}the robot restarted automatically at {r.t:.2f} s {unseen}")
         prev = r
