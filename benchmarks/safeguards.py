@@ -1,7 +1,7 @@
 """The safeguard scenarios of issue 18: each flawed cell searched over seeds (does the searcher find its flaw
 within the budget?), each fixed twin searched with a larger budget to the end (no hazard expected).
 
-    python benchmarks/safeguards.py [--seeds 10] [--budget 200] [--twin-budget 1000] [--searchers plan random]
+    python benchmarks/safeguards.py [--seeds 10] [--budget 200] [--twin-budget 1000] [--searchers plan evolve random]
 
 Prints one Markdown row per cell and searcher: runs that found a hazard, and the mean and median episodes to the
 first hazard (a run that found none counts as the budget); for a twin, the hazards found in its whole budget.
@@ -15,8 +15,8 @@ import statistics
 from cellstress.searchers import search
 from cellstress.sim.simulator import Simulator
 
-FLAWED = ("restart-auto", "warning-field-short")
-TWINS = ("restart-manual", "warning-field-ok")
+FLAWED = ("restart-auto", "warning-field-short", "mat-short")
+TWINS = ("restart-manual", "warning-field-ok", "mat-ok")
 
 
 def main() -> None:
@@ -25,7 +25,7 @@ def main() -> None:
     ap.add_argument("--budget", type=int, default=200)
     ap.add_argument("--twin-budget", type=int, default=1000)
     ap.add_argument("--twin-seeds", type=int, default=1)
-    ap.add_argument("--searchers", nargs="+", default=["plan", "random"])
+    ap.add_argument("--searchers", nargs="+", default=["plan", "evolve", "random"])
     ap.add_argument("--cells", nargs="+", default=list(FLAWED + TWINS))
     args = ap.parse_args()
     print("| cell | searcher | seeds | budget | runs with a hazard | mean episodes to the first | median |")
