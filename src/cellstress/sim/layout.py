@@ -54,7 +54,7 @@ STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
     ("SLOW", "the latched reduction's time scaling (a warning field's reduced_speed)"),
     ("STOP_SEEN", "last time a stopping device saw the worker [s]; -1: never"),
     ("STOP_CLEAR", "clear time [s] the latched stop waits for: the longest automatic restart time of the devices "
-                   "that saw the worker since it latched; inf: one of them restarts manually (never released)"),
+                   "that saw the worker since it latched; inf: one of them restarts manually, or none latched"),
     ("SLOW_SEEN", "last time a warning field saw the worker [s]; -1: never"),
     ("SLOW_CLEAR", "the same for the latched speed reduction"),
     ("RESTARTS", "stops released so far"),

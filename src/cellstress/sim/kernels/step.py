@@ -89,13 +89,15 @@ def sense_and_measure(P, state, W, row, action):
                 sense_warning(P, state, d, t)
                 continue
             t_s = t + P.dev_resp[d]
+            # the clear time a latched stop waits for: its first device's, then the longest of those that see
+            state[S_STOP_CLEAR] = P.dev_clear[d] if state[S_TSTOP] == np.inf else \
+                max(state[S_STOP_CLEAR], P.dev_clear[d])
             if t_s < state[S_TSTOP]:
                 state[S_TSTOP] = t_s
                 if state[S_TRIG_DEV] < 0:
                     state[S_TRIG_T] = t
                 state[S_TRIG_DEV] = d
             state[S_STOP_SEEN] = t
-            state[S_STOP_CLEAR] = max(state[S_STOP_CLEAR], P.dev_clear[d])
     release(P, state, t)
     v, phase, tau = robot_at(P, int(k), state, W)
     cap_r, reach, origin, grid_h, arm_len, fences = P.cap_r, P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], \
@@ -128,11 +130,13 @@ def sense_warning(P, state, d, t):
     t_w = t + P.dev_resp[d]
     if state[S_TSLOW] == np.inf:
         state[S_SLOW] = P.dev_speed[d]
+        state[S_SLOW_CLEAR] = P.dev_clear[d]
+    else:
+        state[S_SLOW_CLEAR] = max(state[S_SLOW_CLEAR], P.dev_clear[d])
     if t_w < state[S_TSLOW]:
         state[S_TSLOW] = t_w
     state[S_LIVE] = 1.0
     state[S_SLOW_SEEN] = t
-    state[S_SLOW_CLEAR] = max(state[S_SLOW_CLEAR], P.dev_clear[d])
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -144,12 +148,12 @@ def release(P, state, t):
     if state[S_TSTOP] < np.inf and t - state[S_STOP_SEEN] >= state[S_STOP_CLEAR]:
         _reanchor(P, state, t, state[S_SLOW] if state[S_TSLOW] <= t else 1.0)
         state[S_TSTOP] = np.inf
-        state[S_STOP_CLEAR] = 0.0
+        state[S_STOP_CLEAR] = np.inf
         state[S_RESTARTS] += 1.0
     if state[S_TSLOW] < np.inf and t - state[S_SLOW_SEEN] >= state[S_SLOW_CLEAR]:
         _reanchor(P, state, t, 0.0 if state[S_TSTOP] <= t else 1.0)
         state[S_TSLOW] = np.inf
-        state[S_SLOW_CLEAR] = 0.0
+        state[S_SLOW_CLEAR] = np.inf
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -171,6 +175,7 @@ def reset_state(P, x, y, heading, state, W, row):
     state[S_TSLOW] = np.inf
     state[S_SLOW] = 1.0
     state[S_STOP_SEEN] = state[S_SLOW_SEEN] = -1.0
+    state[S_STOP_CLEAR] = state[S_SLOW_CLEAR] = np.inf  # nothing to release (a stop set by hand holds, as before)
     sense_and_measure(P, state, W, row, np.int64(-1))  # not a literal: see batch.py
 
 
