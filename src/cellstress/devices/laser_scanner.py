@@ -120,4 +120,5 @@ class LaserScanner(DeviceRecord):
                              zorder=2.6))
         return Patch(facecolor=self.color, alpha=0.4, edgecolor=self.color, ls="--",
                      label=f"scanner field '{self.name}' ({self.height:g} m, {self.response_time:g} s)"
-                     + ("" if self.warning is None else f", warning field dotted ({self.warning.reduced_speed:g})"))
+                     + ("" if self.warning is None else f", warning field dotted ({self.warning.reduced_speed:g})")
+                     + ("" if self.restart == "manual" else f", restarts by itself after {self.clear_time:g} s"))
