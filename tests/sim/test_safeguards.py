@@ -124,3 +124,28 @@ def test_mat_sees_the_feet_only():
     # leaning over the mat's front edge from outside is not seen: standing still, bent forward, at the start
     rows = sim.run(["turn-left-45+bend-forward", "turn-right-45+bend-forward"]).rows
     assert not any(int(s) & mat for s in rows[:, L.M_SEEN])
+
+
+@pytest.mark.parametrize("cell, acts", [
+    ("restart-auto", INTO_BAY + ["walk+bend-forward"] * 4),
+    ("warning-field-ok", ["walk+upright"] * 8),
+])
+def test_replayed_latches_match_the_kernel(cell, acts):
+    """A criterion that judges contacts may end an action early; the simulator then replays the latches from the
+    rows (``_state_at``). Replayed over a whole action, they must give the kernel's own state, bit for bit: the
+    stop, the reduction, the release and its anchor."""
+    from cellstress.sim.simulator import _state_at
+
+    sim = Simulator(cell)
+    state = sim.reset()
+    for a in acts:
+        nxt, rows = sim.step(state, a)
+        again = nxt.copy()
+        again[L.S_TSTOP:L.S_UNSAFE] = 0.0
+        again[L.S_LIVE:] = 0.0
+        _state_at(again, state, rows, sim.params)
+        assert again.tobytes() == nxt.tobytes(), a
+        state = nxt
+        if sim.is_unsafe(state):  # (restart-auto: the action with the release ends at the contact)
+            break
+    assert state[L.S_LIVE] == 1.0

@@ -87,17 +87,8 @@ def sense_and_measure(P, state, W, row, action):
             seen |= 1 << d
             if P.dev_speed[d] != 0.0:  # a warning field: a speed reduction, latched like a stop
                 sense_warning(P, state, d, t)
-                continue
-            t_s = t + P.dev_resp[d]
-            # the clear time a latched stop waits for: its first device's, then the longest of those that see
-            state[S_STOP_CLEAR] = P.dev_clear[d] if state[S_TSTOP] == np.inf else \
-                max(state[S_STOP_CLEAR], P.dev_clear[d])
-            if t_s < state[S_TSTOP]:
-                state[S_TSTOP] = t_s
-                if state[S_TRIG_DEV] < 0:
-                    state[S_TRIG_T] = t
-                state[S_TRIG_DEV] = d
-            state[S_STOP_SEEN] = t
+            else:
+                sense_stop(P, state, d, t)
     release(P, state, t)
     v, phase, tau = robot_at(P, int(k), state, W)
     cap_r, reach, origin, grid_h, arm_len, fences = P.cap_r, P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], \
@@ -121,6 +112,35 @@ def sense_and_measure(P, state, W, row, action):
     if unsafe:
         state[S_UNSAFE] = 1.0
     return unsafe
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def sense_stop(P, state, d, t):
+    """Device d sees the worker at t: a stop is latched, taking effect after its response time (an earlier one
+    replaces a later one)."""
+    t_s = t + P.dev_resp[d]
+    # the clear time a latched stop waits for: its first device's, then the longest of those that see
+    state[S_STOP_CLEAR] = P.dev_clear[d] if state[S_TSTOP] == np.inf else max(state[S_STOP_CLEAR], P.dev_clear[d])
+    if t_s < state[S_TSTOP]:
+        state[S_TSTOP] = t_s
+        if state[S_TRIG_DEV] < 0:
+            state[S_TRIG_T] = t
+        state[S_TRIG_DEV] = d
+    state[S_STOP_SEEN] = t
+
+
+@njit(cache=True, error_model="numpy")
+def latch_seen(P, state, seen, t):
+    """What ``sense_and_measure`` does to the state at t when the devices in the bit mask ``seen`` see the worker:
+    the latches and the releases, without moving or measuring anything (``Simulator`` replays a cut action's
+    rows with it)."""
+    for d in range(P.dev_kind.shape[0]):
+        if seen >> d & 1:
+            if P.dev_speed[d] != 0.0:
+                sense_warning(P, state, d, t)
+            else:
+                sense_stop(P, state, d, t)
+    release(P, state, t)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
