@@ -247,3 +247,28 @@ def test_docs_calibration_example_runs(capsys):
     assert [line.split()[0] for line in out] == ["s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap",
                                                  "baseline"]
     assert float(out[-1].split()[1]) == 0.0  # the baseline is safe
+
+
+@pytest.mark.parametrize("cell, device, required, actual, ok", [
+    ("warning-field-short", "front-scanner", 1.700, 1.389, False),
+    ("warning-field-short", "front-scanner:warning", 2.440, 2.489, True),
+    ("warning-field-ok", "front-scanner", 1.700, 1.789, True),
+    ("mat-short", "front-mat", 1.600, 1.189, False),
+    ("mat-ok", "front-mat", 1.600, 2.089, True),
+])
+def test_safeguard_distances(cell, device, required, actual, ok):
+    """Required against actual for the new device kinds (docs/cells.md gives the arithmetic)."""
+    d = next(c for c in iso.check_cell(cell).devices if c.device == device)
+    assert d.required == pytest.approx(required, abs=5e-4)
+    assert d.actual == pytest.approx(actual, abs=5e-3)
+    assert d.ok is ok
+
+
+def test_automatic_restart_check():
+    bad = iso.check_cell("restart-auto")
+    assert bad.failures() == ["bay-curtain-restart"]
+    (rc,) = bad.restarts
+    assert rc.clear_time == 0.5 and rc.behind.distance < 0.85
+    assert any("restarts while the worker stands unseen" in ln for ln in bad.lines())
+    good = iso.check_cell("restart-manual")
+    assert good.ok and good.restarts == ()

@@ -201,6 +201,35 @@ CASES = [
         ("held once", "wrist_3_joint"),
     ),
     Case("start-inside-fence", _put_fence_on_start, "human.start.xy", ("fence",)),
+    # the safeguards of issue 18: restart, warning field, safety mat
+    Case(
+        "restart-negative-clear-time",
+        lambda c: c["devices"][_index(c, "light-curtain")].update(restart={"automatic": -0.5}),
+        None,
+        ("greater than 0", "-0.5"),
+        lambda c: f"devices[{_index(c, 'light-curtain')}].restart.automatic.automatic",
+    ),
+    Case(
+        "restart-unknown-word",
+        lambda c: c["devices"][_index(c, "light-curtain")].update(restart="auto"),
+        None,
+        ("should be 'manual'", "'auto'"),
+        lambda c: f"devices[{_index(c, 'light-curtain')}].restart.manual",
+    ),
+    Case(
+        "warning-speed-above-one",
+        lambda c: _scanner(c).update(warning={"polygon": _scanner(c)["polygon"], "reduced_speed": 1.5}),
+        None,
+        ("less than 1", "1.5"),
+        lambda c: f"devices[{_index(c, 'laser-scanner')}].warning.reduced_speed",
+    ),
+    Case(
+        "mat-two-point-polygon",
+        lambda c: c["devices"].append({"type": "safety-mat", "name": "mat", "polygon": [[0.0, 2.0], [1.0, 2.0]]}),
+        None,
+        ("at least 3 points",),
+        lambda c: f"devices[{len(c['devices']) - 1}].polygon",
+    ),
     Case("start-inside-table", _put_table_on_start, "human.start.xy", ("table",)),
     Case("start-off-floor", _start_off_floor, "human.start.xy", ("not on the floor",)),
     Case(

@@ -40,3 +40,35 @@ def test_field_must_be_a_simple_polygon():
         scanner(polygon=((0, 0), (1, 1), (1, 0), (0, 1)))
     with pytest.raises(ValidationError, match="greater than or equal to 0"):
         scanner(height=-0.1)
+
+
+WIDE = ((-1.0, -1.0), (2.0, -1.0), (2.0, 2.0), (-1.0, 2.0))
+
+
+def test_warning_field_distances_by_hand():
+    # behind a warning field at r = 0.25: T = 0.35 + 0.25 * 0.15 = 0.3875 s, S = 1600 T + 1080 = 620 + 1080
+    s = scanner(response_time=0.35, warning={"polygon": WIDE, "reduced_speed": 0.25})
+    d = s.required_distance(0.15)
+    assert d.T == pytest.approx(0.3875) and d.S == pytest.approx(1700.0)
+    # the warning field leads it by 1600 * (0.35 + 0.75 * 0.15) = 740 mm
+    w = s.warning_distance(0.15)
+    assert w.S == pytest.approx(2440.0)
+    assert scanner().warning_distance(0.15) is None
+
+
+def test_warning_field_channels():
+    s = scanner(response_time=0.35, warning={"polygon": WIDE, "reduced_speed": 0.4, "restart": {"automatic": 1.0}})
+    stop, warn = s.channels()
+    assert (stop.speed, stop.clear_time, stop.name) == (0.0, float("inf"), "s")
+    assert (warn.speed, warn.clear_time, warn.name) == (0.4, 1.0, "s:warning")
+    assert warn.primitive == ScanPlane(WIDE, 0.3) and s.primitives() == (ScanPlane(FIELD, 0.3),)
+    assert "warning field" in s.describe()
+
+
+def test_restart_field():
+    assert scanner().clear_time == float("inf")
+    assert scanner(restart={"automatic": 0.5}).clear_time == 0.5
+    with pytest.raises(ValidationError, match="greater than 0"):
+        scanner(restart={"automatic": 0.0})
+    with pytest.raises(ValidationError, match="'manual'"):
+        scanner(restart="automatic")

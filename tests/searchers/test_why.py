@@ -77,3 +77,37 @@ def test_old_files_without_the_timeline_still_replay(s1, tmp_path):
     assert old.hazard.why is None
     check = check_result(old, search_again=True)
     assert check.reproduced, check.problems
+
+
+def test_automatic_restart_in_words(tmp_path):
+    """restart-auto: the curtain stopped the robot in time, and the words say it restarted while the worker stood
+    unseen; the result file keeps the words and replays; the static check names the restart."""
+    sim = Simulator("restart-auto")
+    res = search(sim, "plan", budget=200, seed=0)
+    why = res.hazard.why
+    assert why.detected and why.stopped_by == "bay-curtain" and why.late_by_s < 0
+    assert "restarted automatically" in why.safeguards and "while no device saw the worker" in why.safeguards
+    static = check_cell(sim.cell)
+    assert "bay-curtain-restart" in static.failures()
+    assert "then restarted" in shortfall(why, static)
+    path = res.write(tmp_path)
+    assert json.loads(path.read_text())["hazard"]["why"]["safeguards"] == why.safeguards
+    check = check_result(SearchResult.load(path), search_again=True)
+    assert check.reproduced, check.problems
+
+
+def test_warning_field_in_words():
+    sim = Simulator("warning-field-short")
+    res = search(sim, "evolve", budget=200, seed=0)
+    why = res.hazard.why
+    assert why.stopped_by == "front-scanner"
+    assert "front-scanner:warning saw the worker" in why.safeguards and "0.25 of its speed" in why.safeguards
+    words = shortfall(why, check_cell(sim.cell))
+    assert "requires S = 1.70 m" in words and "short by 0.31 m" in words
+
+
+def test_no_safeguard_words_in_old_results(s1):
+    """A cell without the new safeguards writes no ``safeguards`` key: its result files keep their bytes."""
+    res = search(s1, "plan", budget=200, seed=0)
+    assert res.hazard.why.safeguards is None
+    assert "safeguards" not in res.hazard.why.model_dump()

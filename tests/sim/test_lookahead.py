@@ -31,7 +31,7 @@ def brute_gaps(sim, rows, t_stop, horizon, speed):
     for r in rows:
         best = np.inf
         for j in range(int(round(horizon / dt)) + 1):
-            s = np.zeros(L.NS)
+            s = sim.reset()  # (the safeguard slots at their neutral values: nothing latched to release)
             s[L.S_K] = r[L.M_STEP] + j
             s[L.S_X], s[L.S_Y], s[L.S_HEADING], s[L.S_FWD], s[L.S_LAT] = (
                 r[L.M_X], r[L.M_Y], r[L.M_HEADING], r[L.M_FWD], r[L.M_LAT])

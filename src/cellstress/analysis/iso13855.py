@@ -44,6 +44,7 @@ from cellstress.analysis.plane import (
 )
 from cellstress.cell.load import Cell, load_cell
 from cellstress.core.records import ScanPlane, VerticalField
+from cellstress.devices.base import DeviceRecord
 from cellstress.human.body import WALK_BLOCK_HEIGHT
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
@@ -118,16 +119,18 @@ class StaticCheck:
     arm_length: float  # m, the body model's arm (upper arm + forearm + hand)
     episode: float  # s, length of one search episode
     phase_fixed: bool = True  # the worker arrives at the cell's own phase (human.arrival: fixed)
+    restarts: tuple = ()  # RestartCheck of every device with an automatic restart
 
     @property
     def ok(self) -> bool:
-        return all(d.ok for d in self.devices) and self.approach.ok
+        return all(d.ok for d in self.devices) and self.approach.ok and all(r.ok for r in self.restarts)
 
     def failures(self) -> list[str]:
-        """Names of the failed checks: device names and/or 'undetected-reach'."""
+        """Names of the failed checks: device names, 'undetected-reach' and/or 'DEVICE-restart'."""
         out = [d.device for d in self.devices if not d.ok]
         if not self.approach.ok:
             out.append("undetected-reach")
+        out += [f"{r.device}-restart" for r in self.restarts if not r.ok]
         return out
 
     def lines(self) -> list[str]:
@@ -211,7 +214,27 @@ def _device_checks(spec, zone: HazardZone) -> tuple[DeviceCheck, ...]:
         out.append(DeviceCheck(d.name, d.type, d.response_time, stop, iso.T, iso.K, iso.C, required,
                                actual, bool(actual >= required - 1e-9), iso.formula, where,
                                tuple(entries), ep, any(isinstance(p, ScanPlane) for p in d.primitives())))
+        warn = d.warning_distance(stop) if isinstance(d, DeviceRecord) else None
+        if warn is not None:  # the warning field: measured like a field, against its own distance
+            out.append(_warning_check(d, warn, stop, covers, zone, t_ep))
     return tuple(out)
+
+
+def _warning_check(d, iso, stop: float, covers, zone: HazardZone, t_ep: float) -> DeviceCheck:
+    entries, best, ep = [], (math.inf, None), math.inf
+    chans = [c for c in d.channels() if c.speed > 0.0]
+    for c in chans:
+        for q0, q1 in _entry_segments(c.primitive, covers):
+            dist, p, hp, k = segment_to_zone(q0, q1, zone)
+            entries.append((q0, q1, dist))
+            if dist < best[0]:
+                best = (dist, closest_on_zone(zone, p, hp, k))
+            ep = min(ep, segment_to_zone(q0, q1, zone, t_ep)[0])
+    actual, where = best
+    required = iso.S / 1000.0
+    return DeviceCheck(chans[0].name, f"{d.type} warning field", d.response_time, stop, iso.T, iso.K, iso.C,
+                       required, actual, bool(actual >= required - 1e-9), iso.formula, where, tuple(entries), ep,
+                       True)
 
 
 def _entry_segments(prim, covers) -> list[tuple[tuple[float, float], tuple[float, float]]]:
@@ -245,7 +268,11 @@ def _fence_panels(spec, zone: HazardZone, shoulder: float, allowance: float) -> 
     return tuple(out)
 
 
-def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowance: float) -> ApproachCheck:
+def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowance: float,
+                    behind=None) -> ApproachCheck:
+    """The undetected reach from the start point; with ``behind`` (a device's detection primitive), from every
+    floor region next to that zone instead: where a worker who crossed it stands once it no longer sees them
+    (what an automatic restart lets the robot meet)."""
     from scipy import ndimage
 
     body = layout.params.body
@@ -286,6 +313,17 @@ def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowan
         seed = int(near.max())
     detected = seed == 0
     U = (labels == seed) if not detected else np.zeros_like(ok)
+    if behind is not None:  # every region that touches the zone's margin (plus two grid cells): either side
+        if isinstance(behind, ScanPlane):
+            reach = detection_margin(body, behind.height, behind.height) + 2 * h
+            touch = points_in_polygon(X, Y, behind.polygon) | (distance_to_polyline(X, Y, behind.polygon, True)
+                                                                <= reach)
+        else:
+            reach = detection_margin(body, behind.bottom, behind.top) + 2 * h
+            touch = point_segment(X, Y, behind.start[0], behind.start[1], behind.end[0], behind.end[1])[0] <= reach
+        ids = np.unique(labels[touch & ok])
+        U = np.isin(labels, ids[ids > 0])
+        detected = not U.any()
 
     walls = [(p.start, p.end) for p in panels if p.closed] + curtains
     arm_walls = extended_walls(walls)
@@ -317,6 +355,32 @@ def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowan
                          m_scan, m_curtain, stand, float(best), where, bool(best >= allowance - 1e-9))
 
 
+@dataclass(frozen=True)
+class RestartCheck:
+    """A device that restarts the robot by itself: where can a worker who crossed its zone stand, unseen, and
+    how far is the hazard zone from there (IEC 62046 / ISO 13849: automatic restart only where nobody can stay
+    undetected between the device and the hazard)."""
+
+    device: str
+    clear_time: float  # s
+    behind: ApproachCheck  # the undetected reach from the regions next to its zone
+
+    @property
+    def ok(self) -> bool:
+        return self.behind.ok
+
+
+def _restart_checks(spec, layout, zone: HazardZone, panels, lean: float) -> tuple[RestartCheck, ...]:
+    out = []
+    for d in spec.devices:
+        if not isinstance(d, DeviceRecord) or d.restart == "manual":
+            continue
+        for prim in d.primitives():
+            out.append(RestartCheck(d.name, d.clear_time,
+                                    _approach_check(spec, layout, zone, panels, lean, ARM_ALLOWANCE, prim)))
+    return tuple(out)
+
+
 def check_cell(cell: Cell | str | Path, layout=None) -> StaticCheck:
     """Run every static check; ``layout`` (a sim.build.Layout of the same cell) saves rebuilding the robot."""
     if layout is None:
@@ -332,7 +396,8 @@ def check_cell(cell: Cell | str | Path, layout=None) -> StaticCheck:
     lean = lean_reach(layout)
     approach = _approach_check(spec, layout, zone, panels, lean, ARM_ALLOWANCE)
     return StaticCheck(spec.name, zone, devices, approach, panels, shoulder, float(body[L.B_ARM_LEN]),
-                       episode_length(spec), spec.human.arrival == "fixed")
+                       episode_length(spec), spec.human.arrival == "fixed",
+                       _restart_checks(spec, layout, zone, panels, lean))
 
 
 def device_distances(cell: Cell | str | Path, layout=None) -> list[DeviceCheck]:
@@ -401,6 +466,16 @@ def _lines(r: StaticCheck) -> list[str]:
     else:
         out.append(f"  closest: stand at {_xy(a.stand)}, shoulder at {_xy(a.where.point)}, arm path "
                    f"{a.distance:.3f} m >= {a.arm_allowance:.2f} m? {_verdict(a.ok)}{_where(a.where, z.cycle)}")
+    for rc in r.restarts:
+        b = rc.behind
+        out.append(f"{rc.device}: automatic restart after {rc.clear_time:g} s clear; a worker who crossed it stands "
+                   f"unseen on {b.undetected_area:.1f} m^2 next to it")
+        if b.where is None:
+            out.append(f"  from there the hazard zone cannot be reached: {_verdict(rc.ok)}")
+        else:
+            out.append(f"  closest: stand at {_xy(b.stand)}, shoulder at {_xy(b.where.point)}, arm path "
+                       f"{b.distance:.3f} m >= {b.arm_allowance:.2f} m? {_verdict(rc.ok)}{_where(b.where, z.cycle)}"
+                       + ("" if rc.ok else ": the robot restarts while the worker stands unseen within reach"))
     fails = r.failures()
     out.append("result: pass" if not fails else f"result: FAIL ({', '.join(fails)})")
     return out

@@ -25,7 +25,8 @@ from cellstress.human.body import BODY_RADIUS, WALK_BLOCK_HEIGHT
 from cellstress.robot.model import load_robot, resolve_urdf, unknown_urdf_message
 
 BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap", "all-flaws",
-                                  "s2-deceptive", "palletizing", "palletizing-fixed")
+                                  "s2-deceptive", "restart-auto", "restart-manual", "warning-field-short",
+                                  "warning-field-ok", "mat-short", "mat-ok", "palletizing", "palletizing-fixed")
 
 
 @dataclass(frozen=True)

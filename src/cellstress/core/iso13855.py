@@ -14,3 +14,5 @@ MIN_C_BODY = 850.0  # mm, intrusion allowance for devices that do not detect a h
 def mm(x: float) -> str:
     """A distance in millimetres as the formulas print it: whole numbers without decimals."""
     return f"{x:.0f}" if abs(x - round(x)) < 1e-6 else f"{x:.1f}"
+
+C_MAT = 1200.0  # mm, intrusion allowance for pressure-sensitive mats (ISO 13855:2010, pressure-sensitive mats)

@@ -28,7 +28,7 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
-from cellstress.core.records import Contact, IsoDistance, KernelTest, Measures, Primitive
+from cellstress.core.records import Channel, Contact, IsoDistance, KernelTest, Measures, Primitive
 
 
 # ---- rewards and recorders ----------------------------------------------------------------------------------
@@ -198,6 +198,15 @@ class Device(Protocol):
     def describe(self) -> str: ...
 
     def draw(self, ax: Any, color: str) -> Any: ...
+
+
+@runtime_checkable
+class Channels(Protocol):
+    """A device whose detections do more than latch a stop for good (``devices.base.DeviceRecord``: an automatic
+    restart, a warning field's speed reduction): what the kernel senses, primitive by primitive. A device
+    without it gives its ``primitives``, each stopping the robot until a manual reset."""
+
+    def channels(self) -> tuple[Channel, ...]: ...
 
 
 @runtime_checkable

@@ -81,6 +81,20 @@ Primitive = ScanPlane | VerticalField
 
 
 @dataclass(frozen=True)
+class Channel:
+    """One detection primitive of a device and what its detection does (what the kernel senses): ``speed`` 0
+    stops the robot, a fraction in (0, 1) cuts it to that fraction of its path speed (a warning field);
+    ``response_time`` [s] until it takes effect; ``clear_time`` [s] without detection until it is released
+    (inf: never, a manual restart). ``name`` is shown where the channel sees the worker."""
+
+    primitive: Primitive
+    name: str
+    speed: float
+    response_time: float
+    clear_time: float
+
+
+@dataclass(frozen=True)
 class IsoDistance:
     """One ISO 13855 minimum distance S = K T + C: K [mm/s], T [s], C and S [mm], and the arithmetic as text."""
 

@@ -1,8 +1,30 @@
-"""What every safety device record has: a name, a response time, and the record conventions of cell files."""
+"""What every safety device record has: a name, a response time, how the stop it requests is released, and
+the record conventions of cell files."""
 
 from __future__ import annotations
 
+from typing import Annotated, Literal
+
+from pydantic import Discriminator, Tag
+
 from cellstress.core.fields import Name, PositiveTime, Record
+from cellstress.core.records import Channel, IsoDistance
+
+
+class AutomaticRestart(Record):
+    """The stop is released by itself once the device has not seen the worker for ``automatic`` seconds."""
+
+    automatic: PositiveTime
+    """Clear time [s]: how long the device must not see the worker before the robot restarts."""
+
+
+def _restart_kind(v) -> str:
+    return "manual" if isinstance(v, str) else "automatic"
+
+
+# a tagged union, so that a wrong value gets the one message of the form it tried (a word or a mapping)
+Restart = Annotated[Annotated[Literal["manual"], Tag("manual")] | Annotated[AutomaticRestart, Tag("automatic")],
+                    Discriminator(_restart_kind)]
 
 
 class DeviceRecord(Record):
@@ -13,3 +35,21 @@ class DeviceRecord(Record):
     """The device's name, shown in outputs; unique in the cell."""
     response_time: PositiveTime
     """Time [s] from detection to the stop signal."""
+    restart: Restart = "manual"
+    """How its stop is released: ``manual`` (a reset outside the cell: the robot stays stopped for the rest of
+    the episode) or ``{automatic: CLEAR_TIME}`` (the robot restarts once this device has not seen the worker for
+    CLEAR_TIME seconds and no other device holds a stop)."""
+
+    @property
+    def clear_time(self) -> float:
+        """The automatic restart's clear time [s]; inf for a manual restart (the stop is never released)."""
+        return float("inf") if self.restart == "manual" else float(self.restart.automatic)
+
+    def channels(self) -> tuple[Channel, ...]:
+        """What the kernel senses for this device: each detection primitive with its effect. By default every
+        primitive stops the robot; a kind with a warning field adds one that reduces its speed."""
+        return tuple(Channel(p, self.name, 0.0, self.response_time, self.clear_time) for p in self.primitives())
+
+    def warning_distance(self, stopping_time: float) -> IsoDistance | None:
+        """ISO 13855 distance of the device's warning field (a channel that reduces the speed), if it has one."""
+        return None

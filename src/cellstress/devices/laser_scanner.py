@@ -3,6 +3,13 @@
 It sees only what crosses its scan plane inside the field (in practice the legs, at the usual 0.3 m), so a
 worker outside the field may lean over it. ISO 13855:2010, detection zone parallel to the direction of approach:
 S = 1600 mm/s * T + (1200 mm - 0.4 H), with C = 1200 - 0.4 H not below 850 mm.
+
+An optional ``warning`` field (a second polygon at the same height, as real scanners switch field sets) cuts the
+robot to ``reduced_speed`` of its path speed instead of stopping it, ramped over the braking time. The
+protective field behind it may then count with the reduced speed's stopping time (braking from a fraction r
+of full speed at the same deceleration takes r times the stopping time): T = response + r * stopping time. That
+holds only if the reduction has taken full effect before the worker reaches the protective field, so the
+warning field needs a lead of K * (response + (1 - r) * stopping time) in front of that distance.
 """
 
 from __future__ import annotations
@@ -11,10 +18,26 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field
 
-from cellstress.core.fields import Polygon, PositiveTime
+from cellstress.core.fields import Polygon, PositiveTime, Record
 from cellstress.core.iso13855 import K_WALK, MIN_C_BODY, mm
-from cellstress.core.records import IsoDistance, ScanPlane
-from cellstress.devices.base import DeviceRecord
+from cellstress.core.records import Channel, IsoDistance, ScanPlane
+from cellstress.devices.base import DeviceRecord, Restart
+
+
+class WarningField(Record):
+    """A laser scanner's warning field: seeing the worker there cuts the robot's speed instead of stopping it."""
+
+    polygon: Polygon
+    """The warning field's outline on the floor [m] (usually around the protective field)."""
+    reduced_speed: Annotated[float, Field(gt=0.0, lt=1.0)] = 0.25
+    """The fraction of its path speed the robot slows to, ramped over the stopping time."""
+    restart: Restart = "manual"
+    """How the reduction is released: ``manual`` (for the rest of the episode) or ``{automatic: CLEAR_TIME}``
+    (full speed again once the warning field has not seen the worker for CLEAR_TIME seconds)."""
+
+
+def _c(height_mm: float) -> float:
+    return max(MIN_C_BODY, 1200.0 - 0.4 * height_mm)
 
 
 class LaserScanner(DeviceRecord):
@@ -29,6 +52,8 @@ class LaserScanner(DeviceRecord):
     """Height of the scan plane above the floor [m]; it sees what crosses the plane inside the field."""
     response_time: PositiveTime = 0.35
     """Time [s] from detection to the stop signal."""
+    warning: WarningField | None = None
+    """An optional warning field (same height and response time) that reduces the robot's speed."""
 
     detection_phrase: ClassVar[str] = "walks into the field of the laser scanner"
     color: ClassVar[str] = "#f2c300"
@@ -36,25 +61,64 @@ class LaserScanner(DeviceRecord):
     def primitives(self) -> tuple[ScanPlane, ...]:
         return (ScanPlane(tuple(self.polygon), self.height),)
 
+    @property
+    def warning_name(self) -> str:
+        return f"{self.name}:warning"
+
+    def channels(self) -> tuple[Channel, ...]:
+        chans = super().channels()
+        w = self.warning
+        if w is None:
+            return chans
+        clear = float("inf") if w.restart == "manual" else float(w.restart.automatic)
+        return chans + (Channel(ScanPlane(tuple(w.polygon), self.height), self.warning_name, float(w.reduced_speed),
+                                self.response_time, clear),)
+
     def required_distance(self, stopping_time: float) -> IsoDistance:
-        T = self.response_time + stopping_time
         height_mm = self.height * 1000.0
-        c = max(MIN_C_BODY, 1200.0 - 0.4 * height_mm)
+        c = _c(height_mm)
+        c_text = (f"(1200 - 0.4*{mm(height_mm)})" if c == 1200.0 - 0.4 * height_mm else
+                  "850 (C = 1200 - 0.4 H is below 850)")
+        if self.warning is not None:  # behind a warning field: the robot brakes from the reduced speed
+            r = self.warning.reduced_speed
+            T = self.response_time + r * stopping_time
+            s = K_WALK * T + c
+            return IsoDistance(K_WALK, T, c, s, f"at the reduced speed {r:g}: S = 1600*({self.response_time:g} + "
+                                                f"{r:g}*{stopping_time:g}) + {c_text} = {mm(s)} mm")
+        T = self.response_time + stopping_time
         s = K_WALK * T + c
-        formula = f"S = 1600*{T:.2f} + (1200 - 0.4*{mm(height_mm)}) = {mm(s)} mm"
-        if c > 1200.0 - 0.4 * height_mm:
-            formula = f"S = 1600*{T:.2f} + 850 (C = 1200 - 0.4 H is below 850) = {mm(s)} mm"
-        return IsoDistance(K_WALK, T, c, s, formula)
+        return IsoDistance(K_WALK, T, c, s, f"S = 1600*{T:.2f} + {c_text} = {mm(s)} mm")
+
+    def warning_distance(self, stopping_time: float) -> IsoDistance | None:
+        """The warning field's distance: the protective field's S at the reduced speed plus the lead the
+        reduction needs to take full effect, K * (response + (1 - r) * stopping time)."""
+        if self.warning is None:
+            return None
+        r = self.warning.reduced_speed
+        prot = self.required_distance(stopping_time)
+        lead_t = self.response_time + (1.0 - r) * stopping_time
+        s = prot.S + K_WALK * lead_t
+        return IsoDistance(K_WALK, prot.T + lead_t, prot.C, s,
+                           f"S = {mm(prot.S)} (protective, reduced speed) + 1600*({self.response_time:g} + "
+                           f"(1 - {r:g})*{stopping_time:g}) = {mm(s)} mm")
 
     def describe(self) -> str:
-        return f"{len(self.polygon)}-point field at {self.height:g} m"
+        text = f"{len(self.polygon)}-point field at {self.height:g} m"
+        if self.warning is not None:
+            text += f", warning field ({len(self.warning.polygon)} points) to {self.warning.reduced_speed:g} speed"
+        return text + ("" if self.restart == "manual" else f", automatic restart after {self.clear_time:g} s")
 
     def draw(self, ax):
         from matplotlib.patches import Patch, Polygon
 
+        if self.warning is not None:  # drawn under the protective field, dotted, lighter
+            ax.add_patch(Polygon(self.warning.polygon, closed=True, fill=False, edgecolor=self.color, lw=1.2,
+                                 ls=":", zorder=2.55))
         ax.add_patch(Polygon(self.polygon, closed=True, facecolor=self.color, alpha=0.22, edgecolor="none",
                              zorder=2.5))
         ax.add_patch(Polygon(self.polygon, closed=True, fill=False, edgecolor=self.color, lw=1.5, ls="--",
                              zorder=2.6))
         return Patch(facecolor=self.color, alpha=0.4, edgecolor=self.color, ls="--",
-                     label=f"scanner field '{self.name}' ({self.height:g} m, {self.response_time:g} s)")
+                     label=f"scanner field '{self.name}' ({self.height:g} m, {self.response_time:g} s)"
+                     + ("" if self.warning is None else f", warning field dotted ({self.warning.reduced_speed:g})")
+                     + ("" if self.restart == "manual" else f", restarts by itself after {self.clear_time:g} s"))

@@ -85,13 +85,15 @@ class LightCurtain(DeviceRecord):
 
     def describe(self) -> str:
         (x0, y0), (x1, y1) = self.start, self.end
+        restart = "" if self.restart == "manual" else f", automatic restart after {self.clear_time:g} s"
         return (f"({x0:g}, {y0:g})-({x1:g}, {y1:g}), {self.bottom:g}..{self.top:g} m, "
-                f"{self.resolution_mm:g} mm")
+                f"{self.resolution_mm:g} mm{restart}")
 
     def draw(self, ax):
         from matplotlib.lines import Line2D
 
         (x0, y0), (x1, y1) = self.start, self.end
         ax.plot([x0, x1], [y0, y1], color=self.color, lw=5, solid_capstyle="butt", zorder=4.5)
+        restart = "" if self.restart == "manual" else f", restarts by itself after {self.clear_time:g} s"
         return Line2D([], [], color=self.color, lw=5, label=f"light curtain '{self.name}' "
-                      f"({self.bottom:g}-{self.top:g} m, {self.response_time:g} s)")
+                      f"({self.bottom:g}-{self.top:g} m, {self.response_time:g} s{restart})")

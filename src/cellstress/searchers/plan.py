@@ -15,7 +15,9 @@ simulator as a black box; ``plan`` separates what the searcher controls from wha
     alone. The robot point a row names (the one closest to the worker) at time step k therefore lies on the
     robot at step k in every episode that has not been stopped by then. The model keeps these points per
     step, each with its *offset* (the worker's distance to it at the row's pose, less the row's d_HR), and the
-    robot's speed v_R at each step;
+    robot's speed v_R at each step. A warning field's reduced speed is taken as part of that path (exact when
+    the field trips at the same step in every episode); rows from the first braking on are not (an automatic
+    restart resumes the path later than the clock);
   - *the devices*: whether a device sees the worker at a pose (the nearest pose of any row decides), and, per
     device, the time steps from the first detection to braking and to standstill (medians over the episodes
     that showed them; unknown: the robot is taken to keep moving);
@@ -201,14 +203,20 @@ class _Model:
         base = int(self.offsets[actions[0] % len(self.offsets)]) if self.lead else 0
         rows = rows[self.lead:]  # (a first decision's row is the initial state's)
         seen = rows[:, L.M_SEEN].astype(np.int64)
-        braking = np.flatnonzero(rows[:, L.M_PHASE] >= L.PHASE_BRAKING)
-        stopped = np.flatnonzero(rows[:, L.M_PHASE] >= L.PHASE_STOPPED)
+        # (not ``>=``: REDUCED, a warning field's slower running, comes after STOPPED in the phase list)
+        braking = np.flatnonzero((rows[:, L.M_PHASE] == L.PHASE_BRAKING) | (rows[:, L.M_PHASE] == L.PHASE_STOPPED))
+        stopped = np.flatnonzero(rows[:, L.M_PHASE] == L.PHASE_STOPPED)
         for p in range(1 + self.lead, len(actions) + 1):
             n = min((p - self.lead) * self.spa, len(rows))
             b = int(braking[0]) if len(braking) and braking[0] < n else -1
             s = int(stopped[0]) if len(stopped) and stopped[0] < n else -1
             self.prefixes[tuple(actions[:p])] = (n, seen[:n], b, s)
-        on_path = rows[rows[:, L.M_PHASE] <= L.PHASE_PENDING]
+        # the robot on its path: running (at full or, behind a warning field, reduced speed: taken as part of the
+        # path, which is exact when the field trips at the same step in every episode) or with a stop pending,
+        # and before any braking (after a stop, an automatic restart resumes the path later than the clock)
+        phase = rows[:, L.M_PHASE]
+        upto = int(braking[0]) if len(braking) else len(rows)
+        on_path = rows[:upto][(phase[:upto] <= L.PHASE_PENDING) | (phase[:upto] == L.PHASE_REDUCED)]
         if len(on_path):
             pts = on_path[:, [L.M_RX, L.M_RY, L.M_RZ]]
             reach = self.sim.worker_distances(on_path[:, self.pose_cols], pts[:, None, :])[:, 0]

@@ -15,7 +15,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import ConfigDict, Field, TypeAdapter, ValidationError, model_validator
+from pydantic import ConfigDict, Field, TypeAdapter, ValidationError, model_serializer, model_validator
 
 from cellstress.core import registry
 from cellstress.core.fields import Record
@@ -102,6 +102,17 @@ class Why(Record):
     """The unsafe contact [s]."""
     late_by_s: float | None
     """How much earlier the robot needed to stand still: standstill_at_s - contact_at_s [s]."""
+    safeguards: Annotated[str, Field(max_length=2000)] | None = None
+    """What a warning field's speed reduction or an automatic restart did before the contact, in words; None
+    (and absent from the file) when neither happened."""
+
+    @model_serializer(mode="wrap")
+    def _drop_absent(self, handler):
+        # absent rather than null, so that result files of cells without these safeguards keep their bytes
+        out = handler(self)
+        if out.get("safeguards") is None:
+            out.pop("safeguards", None)
+        return out
 
 
 class Hazard(Record):

@@ -15,9 +15,45 @@ def _r(t: float) -> float:
     return round(float(t), 9)  # k * dt carries float noise
 
 
+_STOPPING = ("stop-pending", "braking", "stopped")
+
+
+def safeguard_words(layout, records, unsafe_row: int) -> str | None:
+    """What the speed reductions and automatic restarts of the episode did before the contact, from the rows'
+    devices and stop phases; None when neither happened."""
+    P = layout.params
+    names = layout.device_names
+    warn = {names[i]: (float(P.dev_speed[i]), float(P.dev_resp[i])) for i in range(len(names))
+            if P.dev_speed[i] != 0.0}
+    stop_names = {names[i] for i in range(len(names)) if P.dev_speed[i] == 0.0}
+    parts, seen_warn = [], set()
+    last_stop_seen: tuple[str, float] | None = None
+    prev = None
+    for r in records[: unsafe_row + 1]:
+        for name in r.devices:
+            if name in warn and name not in seen_warn:
+                seen_warn.add(name)
+                frac, resp = warn[name]
+                parts.append(f"{name} saw the worker at {r.t:.2f} s and cut the robot to {frac:g} of its speed "
+                             f"from {_r(r.t + resp):.2f} s")
+            if name in stop_names:
+                last_stop_seen = (name, r.t)
+        if prev is not None and prev.stop_phase in _STOPPING and r.stop_phase not in _STOPPING:
+            who = "" if last_stop_seen is None else \
+                f"{last_stop_seen[0]} last saw the worker at {last_stop_seen[1]:.2f} s; "
+            unseen = "while no device saw the worker" if not r.devices else f"while {', '.join(r.devices)} saw them"
+            parts.append(f"{who}the robot restarted automatically at {r.t:.2f} s {unseen}")
+        prev = r
+    if not parts:
+        return None
+    hit = records[unsafe_row]
+    return "; ".join(parts) + f"; v_R at the contact {hit.v_R:.2f} m/s ({hit.stop_phase})"
+
+
 def explain(layout, records, unsafe_row: int) -> Why:
     """The ``Why`` of the hazard at ``records[unsafe_row]`` (``records``: the episode's ``StepRecord`` rows)."""
     spec = layout.cell.spec
+    words = safeguard_words(layout, records, unsafe_row)
     response = {d.name: float(d.response_time) for d in spec.devices}
     saw: dict[str, float] = {}
     for r in records[: unsafe_row + 1]:
@@ -30,22 +66,26 @@ def explain(layout, records, unsafe_row: int) -> Why:
     stops = [t for t in timings if t.stop_at_s is not None]
     if not stops:
         return Why.model_construct(detected=False, devices=timings, stopped_by=None, braking_from_s=None,
-                                   standstill_at_s=None, contact_at_s=contact, late_by_s=None)
+                                   standstill_at_s=None, contact_at_s=contact, late_by_s=None, safeguards=words)
     first = min(stops, key=lambda t: t.stop_at_s)  # (min keeps the cell's order among equal times)
     standstill = _r(first.stop_at_s + float(spec.robot.stopping_time))
     return Why.model_construct(detected=True, devices=timings, stopped_by=first.device,
                                braking_from_s=first.stop_at_s, standstill_at_s=standstill, contact_at_s=contact,
-                               late_by_s=_r(standstill - contact))
+                               late_by_s=_r(standstill - contact), safeguards=words)
 
 
 def why_words(why: Why) -> str:
     """The timeline in one sentence."""
     if not why.detected:
-        return f"undetected: no device saw the worker before the contact at {why.contact_at_s:.2f} s"
+        extra = "" if why.safeguards is None else f"; {why.safeguards}"
+        return f"undetected: no device saw the worker before the contact at {why.contact_at_s:.2f} s{extra}"
     first = next(t for t in why.devices if t.device == why.stopped_by)
     late = why.late_by_s
+    restarted = why.safeguards is not None and "restarted automatically" in why.safeguards
     verdict = (f"{late:.2f} s too late" if late > 0 else
+               "the robot stood still in time, then restarted" if restarted else
                "the robot stood still in time but the criterion still judged the contact unsafe")
+    extra = "" if why.safeguards is None else f"; {why.safeguards}"
     return (f"{first.device} saw the worker at {first.saw_at_s:.2f} s; its stop took effect at "
             f"{first.stop_at_s:.2f} s; the robot would stand still at {why.standstill_at_s:.2f} s; the contact "
-            f"came at {why.contact_at_s:.2f} s: {verdict}")
+            f"came at {why.contact_at_s:.2f} s: {verdict}{extra}")

@@ -10,7 +10,8 @@ import numpy as np
 from cellstress.cell.load import Cell
 from cellstress.cell.program import held_joints, robot_program
 from cellstress.cell.schema import ObstacleSpec
-from cellstress.core.records import ScanPlane, VerticalField
+from cellstress.core.protocols import Channels
+from cellstress.core.records import Channel, ScanPlane, VerticalField
 from cellstress.human.actions import action_table
 from cellstress.human.body import BodyDimensions
 from cellstress.human.reach import ReachField, reach_field
@@ -26,12 +27,17 @@ SCANNER, CURTAIN = L.DEV_SCANNER, L.DEV_CURTAIN  # detection primitive kinds in 
 
 @dataclass(frozen=True)
 class DeviceArrays:
+    """One row per channel (a device's detection primitive and its effect; one per device unless a device has
+    a warning field)."""
+
     kind: np.ndarray  # (nd,) int64
     response: np.ndarray  # (nd,) s
     rect: np.ndarray  # (nd, 6): vertical field x0 y0 x1 y1 bottom top; scan plane [4] = its height
     poly: np.ndarray  # (nd, 2) int64: start and count of each scan plane's polygon in verts
     verts: np.ndarray  # (V, 2)
     names: tuple[str, ...]
+    speed: np.ndarray  # (nd,) 0: the channel stops the robot; else the reduced speed's fraction
+    clear: np.ndarray  # (nd,) s without detection before its stop or reduction is released; inf: manual
 
 
 def pack_polygons(polys) -> tuple[np.ndarray, np.ndarray]:
@@ -45,27 +51,35 @@ def pack_polygons(polys) -> tuple[np.ndarray, np.ndarray]:
 
 def device_arrays(devices) -> DeviceArrays:
     """The kernel's arrays of the cell's devices, from each device's detection primitive."""
-    kinds, resp, rects, polys = [], [], [], []
+    kinds, resp, rects, polys, names, speed, clear = [], [], [], [], [], [], []
     for d in devices:
-        prims = d.primitives()
-        if len(prims) != 1:
-            raise NotImplementedError(f"device {d.name!r}: the kernel takes one detection primitive per device")
-        prim = prims[0]
-        resp.append(d.response_time)
-        if isinstance(prim, ScanPlane):
-            kinds.append(SCANNER)
-            rects.append((0.0, 0.0, 0.0, 0.0, prim.height, prim.height))
-            polys.append(prim.polygon)
-        elif isinstance(prim, VerticalField):
-            kinds.append(CURTAIN)
-            rects.append((*prim.start, *prim.end, prim.bottom, prim.top))
-            polys.append(())
-        else:
-            raise TypeError(f"device {d.name!r}: unknown detection primitive {type(prim).__name__}")
+        chans = d.channels() if isinstance(d, Channels) else \
+            tuple(Channel(p, d.name, 0.0, d.response_time, np.inf) for p in d.primitives())
+        if sum(c.speed == 0.0 for c in chans) != 1:
+            raise NotImplementedError(f"device {d.name!r}: the kernel takes one stopping primitive per device")
+        for c in chans:
+            _channel(d, c.primitive, kinds, rects, polys)
+            resp.append(c.response_time)
+            names.append(c.name)
+            speed.append(c.speed)
+            clear.append(c.clear_time)
     verts, index = pack_polygons(polys)
     return DeviceArrays(np.asarray(kinds, dtype=np.int64), np.asarray(resp, dtype=float),
-                        np.asarray(rects, dtype=float).reshape(-1, 6), index, verts,
-                        tuple(d.name for d in devices))
+                        np.asarray(rects, dtype=float).reshape(-1, 6), index, verts, tuple(names),
+                        np.asarray(speed, dtype=float), np.asarray(clear, dtype=float))
+
+
+def _channel(d, prim, kinds, rects, polys) -> None:
+    if isinstance(prim, ScanPlane):
+        kinds.append(SCANNER)
+        rects.append((0.0, 0.0, 0.0, 0.0, prim.height, prim.height))
+        polys.append(prim.polygon)
+    elif isinstance(prim, VerticalField):
+        kinds.append(CURTAIN)
+        rects.append((*prim.start, *prim.end, prim.bottom, prim.top))
+        polys.append(())
+    else:
+        raise TypeError(f"device {d.name!r}: unknown detection primitive {type(prim).__name__}")
 
 
 @dataclass(frozen=True)
@@ -82,6 +96,13 @@ class Layout:
     params: K.SimParams
     joints: JointMap  # the joints the program drives; the others are held or mimic ones
     obstacles: tuple[ObstacleSpec, ...] = ()  # the table's polygons, the cell's obstacles, the robot's pedestal
+
+    @property
+    def stops_latch(self) -> bool:
+        """True when every stop holds for the rest of the episode and no device changes the robot's speed
+        otherwise (every device restarts manually, none has a warning field): once a latched stop has taken
+        full effect the robot is at rest for good. False with an automatic restart or a warning field."""
+        return bool(np.all(self.params.dev_clear == np.inf) and np.all(self.params.dev_speed == 0.0))
 
 
 PEDESTAL = "robot-pedestal"
@@ -186,6 +207,8 @@ def build_layout(cell: Cell) -> Layout:
         dev_rect=dev.rect,
         dev_poly=dev.poly,
         dev_verts=dev.verts,
+        dev_speed=dev.speed,
+        dev_clear=dev.clear,
         pre_ra=np.zeros((0, len(caps), 3)),
         pre_rb=np.zeros((0, len(caps), 3)),
         pre_v=np.zeros(0),

@@ -43,9 +43,26 @@ STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
     ("TRIG_T", "time of the first detection [s]; -1: none"),
     ("UNSAFE", "1 once a step was unsafe: the episode has ended and the state no longer moves"),
     ("ACTIONS", "actions played so far"),
+    # safeguards (issue 18): restart and speed reduction; appended, so the slots above never move
+    ("LIVE", "1 once a stop was released or a speed reduction latched: the robot is computed live from the "
+             "anchor below (0: path time = phase + t until TSTOP, the pre-stop table)"),
+    ("A_T", "anchor: time of the last release [s] (0 at reset)"),
+    ("A_TAU", "anchor: path time at A_T, less the cell's phase [s]"),
+    ("A_SIG", "anchor: time scaling dtau/dt at A_T"),
+    ("A_TGT", "anchor: time scaling the path ramps to after A_T (at 1 / stopping time per second)"),
+    ("TSLOW", "time the latched speed reduction takes effect [s]; inf: none latched"),
+    ("SLOW", "the latched reduction's time scaling (a warning field's reduced_speed)"),
+    ("STOP_SEEN", "last time a stopping device saw the worker [s]; -1: never"),
+    ("STOP_CLEAR", "clear time [s] the latched stop waits for: the longest automatic restart time of the devices "
+                   "that saw the worker since it latched; inf: one of them restarts manually, or none latched"),
+    ("SLOW_SEEN", "last time a warning field saw the worker [s]; -1: never"),
+    ("SLOW_CLEAR", "the same for the latched speed reduction"),
+    ("RESTARTS", "stops released so far"),
 ))
-S_K, S_X, S_Y, S_HEADING, S_FWD, S_LAT, S_TSTOP, S_TRIG_DEV, S_TRIG_T, S_UNSAFE, S_ACTIONS = STATE.indices(
-    "K", "X", "Y", "HEADING", "FWD", "LAT", "TSTOP", "TRIG_DEV", "TRIG_T", "UNSAFE", "ACTIONS")
+(S_K, S_X, S_Y, S_HEADING, S_FWD, S_LAT, S_TSTOP, S_TRIG_DEV, S_TRIG_T, S_UNSAFE, S_ACTIONS, S_LIVE, S_A_T, S_A_TAU,
+ S_A_SIG, S_A_TGT, S_TSLOW, S_SLOW, S_STOP_SEEN, S_STOP_CLEAR, S_SLOW_SEEN, S_SLOW_CLEAR, S_RESTARTS) = STATE.indices(
+    "K", "X", "Y", "HEADING", "FWD", "LAT", "TSTOP", "TRIG_DEV", "TRIG_T", "UNSAFE", "ACTIONS", "LIVE", "A_T", "A_TAU",
+    "A_SIG", "A_TGT", "TSLOW", "SLOW", "STOP_SEEN", "STOP_CLEAR", "SLOW_SEEN", "SLOW_CLEAR", "RESTARTS")
 NS = STATE.size
 
 ROW = VectorSpec("metric row (one per time step; row 0 of an episode is its start)", (
@@ -83,8 +100,10 @@ PHASE = VectorSpec("robot stop phase (values of the row's PHASE; records.STOP_PH
     ("PENDING", "a stop is latched and takes effect later (the device's response time)"),
     ("BRAKING", "slowing linearly to a standstill within the stopping time"),
     ("STOPPED", "standing"),
+    ("REDUCED", "no stop latched; a warning field's speed reduction is latched (pending or in effect)"),
 ))
-PHASE_RUNNING, PHASE_PENDING, PHASE_BRAKING, PHASE_STOPPED = PHASE.indices("RUNNING", "PENDING", "BRAKING", "STOPPED")
+PHASE_RUNNING, PHASE_PENDING, PHASE_BRAKING, PHASE_STOPPED, PHASE_REDUCED = PHASE.indices(
+    "RUNNING", "PENDING", "BRAKING", "STOPPED", "REDUCED")
 
 SCALARS = VectorSpec("scalar parameters (SimParams.scal)", (
     ("DT", "time step [s]"),

@@ -12,7 +12,7 @@ from pydantic import Field
 
 from cellstress.core.fields import Record
 
-STOP_PHASES = ("running", "stop-pending", "braking", "stopped")
+STOP_PHASES = ("running", "stop-pending", "braking", "stopped", "reduced-speed")
 Name = Annotated[str, Field(max_length=200)]
 Coordinate = tuple[float, float, float]
 
@@ -32,7 +32,7 @@ class StepRecord(Record):
     d_HR: float | None  # None only where a file held a non-finite number
     v_R: float | None
     devices: Annotated[tuple[Name, ...], Field(max_length=64)]
-    stop_phase: Literal["running", "stop-pending", "braking", "stopped"]
+    stop_phase: Literal["running", "stop-pending", "braking", "stopped", "reduced-speed"]
     robot_link: Name | None
     body_part: Name | None
     robot_point: Coordinate

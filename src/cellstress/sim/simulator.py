@@ -191,7 +191,7 @@ class Simulator:
                 rows[i, L.M_UNSAFE] = 1.0
                 nxt[L.S_UNSAFE] = 1.0
                 if i < n - 1:
-                    _state_at(nxt, state, rows, self.params.dev_resp)
+                    _state_at(nxt, state, rows, self.params)
         return nxt, rows
 
     def step_many(self, states: np.ndarray, actions: np.ndarray) -> np.ndarray:
@@ -353,20 +353,16 @@ def _action_array(actions) -> np.ndarray:
     return acts
 
 
-def _state_at(nxt: np.ndarray, before: np.ndarray, rows: np.ndarray, resp: np.ndarray) -> None:
+def _state_at(nxt: np.ndarray, before: np.ndarray, rows: np.ndarray, params) -> None:
     """Turn ``nxt``, the state at the end of an action played from ``before``, into the state at the step of
-    ``rows[-1]``, where a criterion ended the episode: the clock and pose from that row, and the stop latch
-    replayed from the devices each row saw, as ``kernels.sense_and_measure`` latches it."""
+    ``rows[-1]``, where a criterion ended the episode: the clock and pose from that row, and the latches (stops,
+    speed reductions, releases) replayed from the devices each row saw, by the kernel's own code
+    (``kernels.latch_seen``, as ``kernels.sense_and_measure`` latches them)."""
     row = rows[-1]
     nxt[L.S_K] = row[L.M_STEP]
     nxt[L.S_X], nxt[L.S_Y], nxt[L.S_HEADING] = row[L.M_X], row[L.M_Y], row[L.M_HEADING]
     nxt[L.S_FWD], nxt[L.S_LAT] = row[L.M_FWD], row[L.M_LAT]
     nxt[L.S_TSTOP], nxt[L.S_TRIG_DEV], nxt[L.S_TRIG_T] = before[L.S_TSTOP], before[L.S_TRIG_DEV], before[L.S_TRIG_T]
+    nxt[L.S_LIVE:] = before[L.S_LIVE:]  # the safeguard slots, appended after ACTIONS
     for r in rows:
-        seen, t = int(r[L.M_SEEN]), r[L.M_T]
-        for d in range(len(resp)):
-            if seen >> d & 1 and t + resp[d] < nxt[L.S_TSTOP]:
-                nxt[L.S_TSTOP] = t + resp[d]
-                if nxt[L.S_TRIG_DEV] < 0:
-                    nxt[L.S_TRIG_T] = t
-                nxt[L.S_TRIG_DEV] = d
+        K.latch_seen(params, nxt, np.int64(r[L.M_SEEN]), float(r[L.M_T]))

@@ -33,6 +33,7 @@ from cellstress.sim.kernels.robot import (
 from cellstress.sim.kernels.sensing import device_sees, trunk_clear
 from cellstress.sim.kernels.separation import separation
 from cellstress.sim.kernels.step import (
+    latch_seen,
     reset_state,
     sense_and_measure,
     step_action,
@@ -48,6 +49,6 @@ __all__ = [
     "reach_value", "TRACE_REL_TOL",
     "device_sees", "trunk_clear",
     "separation",
-    "reset_state", "sense_and_measure", "step_action", "worker_paths", "worker_point_distances",
+    "reset_state", "sense_and_measure", "step_action", "worker_paths", "worker_point_distances", "latch_seen",
     "run_episode", "run_batch", "make_handle", "step_with_handle",
 ]

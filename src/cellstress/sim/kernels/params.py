@@ -41,6 +41,8 @@ class SimParams(NamedTuple):
     dev_rect: np.ndarray  # (nd, 6) curtain rectangle; for scanners [4] holds the scan height
     dev_poly: np.ndarray  # (nd, 2) int64 start, count into dev_verts
     dev_verts: np.ndarray  # (V, 2)
+    dev_speed: np.ndarray  # (nd,) 0: detection latches a stop; else a warning field's reduced speed fraction
+    dev_clear: np.ndarray  # (nd,) automatic restart's clear time [s]; inf: manual (latched for the episode)
     pre_ra: np.ndarray  # (n_pre, nc, 3) robot capsules at step k before any stop (a cache: see robot_at)
     pre_rb: np.ndarray
     pre_v: np.ndarray  # (n_pre,) v_R

@@ -4,6 +4,12 @@ time and stop.
 The robot is a pure function of time and of the moment its stop takes effect: its path time advances one
 second per second until the stop, then slows linearly to a standstill within the stopping time, so
 tau(t) = t_s + d - d^2 / (2 T) for d = t - t_s < T. Nothing is integrated, so nothing drifts.
+
+With the safeguards of issue 18 (a stop released by an automatic restart, a warning field's speed reduction) the
+time scaling sigma = dtau/dt is piecewise linear: from an anchor (a release's time, path time and sigma, kept in
+the state) it ramps at 1 / T per second towards a target (1 after a restart, the reduced speed, 0 for a stop),
+and the latched reduction and stop, when they take effect, lower the target. Every piece is integrated in closed
+form (``live_path_time``), so the robot is still a pure function of the state and the time.
 """
 
 from __future__ import annotations
@@ -22,8 +28,17 @@ from cellstress.sim.layout import (
     JOINT_PRISMATIC,
     PHASE_BRAKING,
     PHASE_PENDING,
+    PHASE_REDUCED,
     PHASE_RUNNING,
     PHASE_STOPPED,
+    S_A_SIG,
+    S_A_T,
+    S_A_TAU,
+    S_A_TGT,
+    S_LIVE,
+    S_SLOW,
+    S_TSLOW,
+    S_TSTOP,
 )
 
 
@@ -40,6 +55,57 @@ def path_time(scal, t, t_stop):
     if d >= T:
         return tau0 + t_stop + 0.5 * T, 0.0, PHASE_STOPPED
     return tau0 + t_stop + d - d * d / (2.0 * T), 1.0 - d / T, PHASE_BRAKING
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _ramp(a_t, tau, sig, tgt, t, T):
+    """(path time, sigma) at t >= a_t for sigma ramping from ``sig`` towards ``tgt`` at 1/T per second (the
+    robot's braking rate: full speed to standstill in the stopping time T), then holding it."""
+    d = t - a_t
+    diff = tgt - sig
+    if diff == 0.0:
+        return tau + sig * d, sig
+    dur = abs(diff) * T
+    if d >= dur:
+        return tau + 0.5 * (sig + tgt) * dur + tgt * (d - dur), tgt
+    if diff > 0.0:
+        return tau + sig * d + d * d / (2.0 * T), sig + d / T
+    return tau + sig * d - d * d / (2.0 * T), sig - d / T
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def live_path_time(scal, state, t):
+    """(path time, sigma, stop phase) at time t of a state whose robot left the plain model (``S_LIVE``): from
+    the anchor, the latched reduction (target SLOW at TSLOW) and the latched stop (target 0 at TSTOP) in the
+    order they take effect; an event at or before the anchor is already folded into its target."""
+    T = scal[C_STOP_TIME]
+    a_t, tau, sig, tgt = state[S_A_T], state[S_A_TAU], state[S_A_SIG], state[S_A_TGT]
+    e1, g1 = state[S_TSLOW], state[S_SLOW]
+    e2 = state[S_TSTOP]
+    if not e1 > a_t:
+        e1 = np.inf
+    if not e2 > a_t:
+        e2 = np.inf
+    g2 = 0.0
+    if e2 < e1:
+        e1, g1, e2, g2 = e2, g2, e1, g1
+    if e1 <= t:
+        tau, sig = _ramp(a_t, tau, sig, tgt, e1, T)
+        a_t, tgt = e1, min(tgt, g1)
+        if e2 <= t:
+            tau, sig = _ramp(a_t, tau, sig, tgt, e2, T)
+            a_t, tgt = e2, min(tgt, g2)
+    tau, sig = _ramp(a_t, tau, sig, tgt, t, T)
+    t_stop = state[S_TSTOP]
+    if t_stop <= t:
+        phase = PHASE_BRAKING if sig > 0.0 else PHASE_STOPPED
+    elif t_stop < np.inf:
+        phase = PHASE_PENDING
+    elif state[S_TSLOW] < np.inf:
+        phase = PHASE_REDUCED
+    else:
+        phase = PHASE_RUNNING
+    return scal[C_PHASE0] + tau, sig, phase
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -178,21 +244,22 @@ def _robot_capsules(cap_joint, cap_a, cap_b, base, rot, pos, ra, rb):
 def robot_live(P, t, t_stop, W):
     """Pose the robot at time t: capsules into W.ra/W.rb. Returns (v_R, stop phase, path time)."""
     W.stopped[0] = np.nan
-    return _robot_live(P.scal, P.seg_start, P.seg_move, P.seg_dwell, P.wp, P.parents, P.placements, P.base,
-                       P.axes, P.jtype, P.anc, P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot, W.pos, W.ra, W.rb,
-                       t, t_stop)
+    tau, sigma, phase = path_time(P.scal, t, t_stop)
+    v = _robot_live(P.scal, P.seg_start, P.seg_move, P.seg_dwell, P.wp, P.parents, P.placements, P.base,
+                    P.axes, P.jtype, P.anc, P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot, W.pos, W.ra, W.rb,
+                    tau, sigma)
+    return v, phase, tau
 
 
 # Not inlined: robot_live (the pre-stop table, pictures) and robot_at (the step, after a stop) share one
 # compiled copy. It takes arrays only and allocates nothing (NO_REFCOUNT).
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def _robot_live(scal, seg_start, seg_move, seg_dwell, wp, parents, placements, base, axes, jtype, anc, cap_joint,
-                cap_a, cap_b, q, qd, rot, pos, ra, rb, t, t_stop):
-    tau, sigma, phase = path_time(scal, t, t_stop)
+                cap_a, cap_b, q, qd, rot, pos, ra, rb, tau, sigma):
     _joint_trajectory(scal, seg_start, seg_move, seg_dwell, wp, tau, sigma, q, qd)
     _forward_kinematics(parents, placements, base, axes, jtype, q, rot, pos)
     _robot_capsules(cap_joint, cap_a, cap_b, base, rot, pos, ra, rb)
-    return _fastest_joint_speed(anc, axes, jtype, qd, rot, pos), phase, tau
+    return _fastest_joint_speed(anc, axes, jtype, qd, rot, pos)
 
 
 # The same with SimParams / Work, for callers outside the hot loop (tests, scene, the ISO check).
@@ -217,13 +284,21 @@ def robot_capsules(P, rot, pos, ra, rb):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def robot_at(P, k, t_stop, W):
+def robot_at(P, k, state, W):
     """The robot at step k. Until a stop takes effect every episode moves the robot identically, so those
     steps come from a table made once per cell by the same code (bit-identical to computing them). Once the
     robot stands, its pose no longer changes: W.stopped = (t_stop, v_R) marks that W.ra/W.rb hold the
-    standstill pose for that stop (NaN: they do not)."""
+    standstill pose for that stop (NaN: they do not). A state that left the plain model (a released stop, a
+    speed reduction: ``S_LIVE``) is posed live at every step, from ``live_path_time``."""
     scal, ra, rb, stopped = P.scal, W.ra, W.rb, W.stopped
     t = k * scal[C_DT]
+    t_stop = state[S_TSTOP]
+    if state[S_LIVE] != 0.0:
+        stopped[0] = np.nan
+        tau, sigma, phase = live_path_time(scal, state, t)
+        v = _robot_live(scal, P.seg_start, P.seg_move, P.seg_dwell, P.wp, P.parents, P.placements, P.base, P.axes,
+                        P.jtype, P.anc, P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot, W.pos, ra, rb, tau, sigma)
+        return v, phase, tau
     pre_v = P.pre_v
     if t < t_stop and k < pre_v.shape[0]:
         pre_ra, pre_rb = P.pre_ra, P.pre_rb
@@ -236,9 +311,9 @@ def robot_at(P, k, t_stop, W):
     if stopped[0] == t_stop and t - t_stop >= scal[C_STOP_TIME]:
         tau, _, phase = path_time(scal, t, t_stop)
         return stopped[1], phase, tau
-    v, phase, tau = _robot_live(scal, P.seg_start, P.seg_move, P.seg_dwell, P.wp, P.parents, P.placements,
-                                P.base, P.axes, P.jtype, P.anc, P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot,
-                                W.pos, ra, rb, t, t_stop)
+    tau, sigma, phase = path_time(scal, t, t_stop)
+    v = _robot_live(scal, P.seg_start, P.seg_move, P.seg_dwell, P.wp, P.parents, P.placements, P.base, P.axes,
+                    P.jtype, P.anc, P.cap_joint, P.cap_a, P.cap_b, W.q, W.qd, W.rot, W.pos, ra, rb, tau, sigma)
     if phase == PHASE_STOPPED:
         stopped[0], stopped[1] = t_stop, v
     else:

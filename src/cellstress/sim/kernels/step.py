@@ -15,7 +15,7 @@ from cellstress.sim.geometry import NO_REFCOUNT, segment_segment_xyz
 from cellstress.sim.kernels.body import pose_body
 from cellstress.sim.kernels.fences import collect_near_fences
 from cellstress.sim.kernels.reach import reach_value_at
-from cellstress.sim.kernels.robot import robot_at
+from cellstress.sim.kernels.robot import live_path_time, robot_at
 from cellstress.sim.kernels.sensing import device_sees, feet_ok, trunk_clear
 from cellstress.sim.kernels.separation import separation
 from cellstress.sim.layout import (
@@ -24,6 +24,7 @@ from cellstress.sim.layout import (
     B_WALK_SPEED,
     C_DT,
     C_DTOL,
+    C_PHASE0,
     C_REACH_H,
     C_REACH_ORIGIN,
     C_VTOL,
@@ -42,13 +43,25 @@ from cellstress.sim.layout import (
     M_Y,
     N_BODY_CAPSULES,
     NS,
+    S_A_SIG,
+    S_A_T,
+    S_A_TAU,
+    S_A_TGT,
     S_ACTIONS,
     S_FWD,
     S_HEADING,
     S_K,
     S_LAT,
+    S_LIVE,
+    S_RESTARTS,
+    S_SLOW,
+    S_SLOW_CLEAR,
+    S_SLOW_SEEN,
+    S_STOP_CLEAR,
+    S_STOP_SEEN,
     S_TRIG_DEV,
     S_TRIG_T,
+    S_TSLOW,
     S_TSTOP,
     S_UNSAFE,
     S_X,
@@ -72,13 +85,12 @@ def sense_and_measure(P, state, W, row, action):
     for d in range(dev_kind.shape[0]):
         if device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
             seen |= 1 << d
-            t_s = t + P.dev_resp[d]
-            if t_s < state[S_TSTOP]:
-                state[S_TSTOP] = t_s
-                if state[S_TRIG_DEV] < 0:
-                    state[S_TRIG_T] = t
-                state[S_TRIG_DEV] = d
-    v, phase, tau = robot_at(P, int(k), state[S_TSTOP], W)
+            if P.dev_speed[d] != 0.0:  # a warning field: a speed reduction, latched like a stop
+                sense_warning(P, state, d, t)
+            else:
+                sense_stop(P, state, d, t)
+    release(P, state, t)
+    v, phase, tau = robot_at(P, int(k), state, W)
     cap_r, reach, origin, grid_h, arm_len, fences = P.cap_r, P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], \
         P.body[B_ARM_LEN], P.fences
     ra, rb, near, lbs, ts, q = W.ra, W.rb, W.near, W.lbs, W.ts, W.best_r
@@ -102,6 +114,75 @@ def sense_and_measure(P, state, W, row, action):
     return unsafe
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def sense_stop(P, state, d, t):
+    """Device d sees the worker at t: a stop is latched, taking effect after its response time (an earlier one
+    replaces a later one)."""
+    t_s = t + P.dev_resp[d]
+    # the clear time a latched stop waits for: its first device's, then the longest of those that see
+    state[S_STOP_CLEAR] = P.dev_clear[d] if state[S_TSTOP] == np.inf else max(state[S_STOP_CLEAR], P.dev_clear[d])
+    if t_s < state[S_TSTOP]:
+        state[S_TSTOP] = t_s
+        if state[S_TRIG_DEV] < 0:
+            state[S_TRIG_T] = t
+        state[S_TRIG_DEV] = d
+    state[S_STOP_SEEN] = t
+
+
+@njit(cache=True, error_model="numpy")
+def latch_seen(P, state, seen, t):
+    """What ``sense_and_measure`` does to the state at t when the devices in the bit mask ``seen`` see the worker:
+    the latches and the releases, without moving or measuring anything (``Simulator`` replays a cut action's
+    rows with it)."""
+    for d in range(P.dev_kind.shape[0]):
+        if seen >> d & 1:
+            if P.dev_speed[d] != 0.0:
+                sense_warning(P, state, d, t)
+            else:
+                sense_stop(P, state, d, t)
+    release(P, state, t)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def sense_warning(P, state, d, t):
+    """Warning field d sees the worker at t: its speed reduction is latched (the first one's fraction holds
+    until it is released), taking effect after the response time; the robot leaves the plain path model."""
+    t_w = t + P.dev_resp[d]
+    if state[S_TSLOW] == np.inf:
+        state[S_SLOW] = P.dev_speed[d]
+        state[S_SLOW_CLEAR] = P.dev_clear[d]
+    else:
+        state[S_SLOW_CLEAR] = max(state[S_SLOW_CLEAR], P.dev_clear[d])
+    if t_w < state[S_TSLOW]:
+        state[S_TSLOW] = t_w
+    state[S_LIVE] = 1.0
+    state[S_SLOW_SEEN] = t
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def release(P, state, t):
+    """Automatic restart: a latched stop (or speed reduction) is released at t once no device that latched it
+    has seen the worker for the longest clear time among them (never if one of them restarts manually: its
+    clear time is inf). The path is re-anchored there, in closed form, and ramps back up to full speed (or to
+    the reduced speed, if a reduction is in effect); a later detection latches anew."""
+    if state[S_TSTOP] < np.inf and t - state[S_STOP_SEEN] >= state[S_STOP_CLEAR]:
+        _reanchor(P, state, t, state[S_SLOW] if state[S_TSLOW] <= t else 1.0)
+        state[S_TSTOP] = np.inf
+        state[S_STOP_CLEAR] = np.inf
+        state[S_RESTARTS] += 1.0
+    if state[S_TSLOW] < np.inf and t - state[S_SLOW_SEEN] >= state[S_SLOW_CLEAR]:
+        _reanchor(P, state, t, 0.0 if state[S_TSTOP] <= t else 1.0)
+        state[S_TSLOW] = np.inf
+        state[S_SLOW_CLEAR] = np.inf
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _reanchor(P, state, t, target):
+    state[S_LIVE] = 1.0  # (the anchor of reset is the plain model's path: phase + t, braking from TSTOP)
+    tau, sig, _ = live_path_time(P.scal, state, t)
+    state[S_A_T], state[S_A_TAU], state[S_A_SIG], state[S_A_TGT] = t, tau - P.scal[C_PHASE0], sig, target
+
+
 @njit(cache=True, error_model="numpy")
 def reset_state(P, x, y, heading, state, W, row):
     state[:] = 0.0
@@ -109,6 +190,12 @@ def reset_state(P, x, y, heading, state, W, row):
     state[S_TSTOP] = np.inf
     state[S_TRIG_DEV] = -1.0
     state[S_TRIG_T] = -1.0
+    # the safeguards' slots: the anchor of the plain path (phase + t), nothing latched, nothing seen
+    state[S_A_SIG] = state[S_A_TGT] = 1.0
+    state[S_TSLOW] = np.inf
+    state[S_SLOW] = 1.0
+    state[S_STOP_SEEN] = state[S_SLOW_SEEN] = -1.0
+    state[S_STOP_CLEAR] = state[S_SLOW_CLEAR] = np.inf  # nothing to release (a stop set by hand holds, as before)
     sense_and_measure(P, state, W, row, np.int64(-1))  # not a literal: see batch.py
 
 
