@@ -90,3 +90,15 @@ def test_a_robot_at_rest_stays_at_rest() -> None:
                 rested += 1
                 break
     assert rested > 20
+
+
+def test_no_bound_when_a_device_restarts_or_slows_the_robot():
+    # an automatic restart breaks "at rest for good", a warning field "full path speed until the stop"
+    from cellstress.verifier.bounds import Bounds
+
+    for cell in ("restart-auto", "warning-field-short"):
+        sim = Simulator(cell)
+        assert not sim.layout.stops_latch
+        b = Bounds(sim)
+        assert not b.at_rest and b.swept is None
+    assert Bounds(Simulator("restart-manual")).at_rest
