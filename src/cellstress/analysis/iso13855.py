@@ -201,15 +201,7 @@ def _device_checks(spec, zone: HazardZone) -> tuple[DeviceCheck, ...]:
     out = []
     for d in spec.devices:
         iso = d.required_distance(stop)
-        entries, best, ep = [], (math.inf, None), math.inf
-        for prim in d.primitives():
-            for q0, q1 in _entry_segments(prim, covers):
-                dist, p, hp, k = segment_to_zone(q0, q1, zone)
-                entries.append((q0, q1, dist))
-                if dist < best[0]:
-                    best = (dist, closest_on_zone(zone, p, hp, k))
-                ep = min(ep, segment_to_zone(q0, q1, zone, t_ep)[0])
-        actual, where = best
+        entries, actual, where, ep = _entries_to_zone(d.primitives(), covers, zone, t_ep)
         required = iso.S / 1000.0
         out.append(DeviceCheck(d.name, d.type, d.response_time, stop, iso.T, iso.K, iso.C, required,
                                actual, bool(actual >= required - 1e-9), iso.formula, where,
@@ -221,20 +213,26 @@ def _device_checks(spec, zone: HazardZone) -> tuple[DeviceCheck, ...]:
 
 
 def _warning_check(d, iso, stop: float, covers, zone: HazardZone, t_ep: float) -> DeviceCheck:
-    entries, best, ep = [], (math.inf, None), math.inf
     chans = [c for c in d.channels() if c.speed > 0.0]
-    for c in chans:
-        for q0, q1 in _entry_segments(c.primitive, covers):
+    entries, actual, where, ep = _entries_to_zone([c.primitive for c in chans], covers, zone, t_ep)
+    required = iso.S / 1000.0
+    return DeviceCheck(chans[0].name, f"{d.type} warning field", d.response_time, stop, iso.T, iso.K, iso.C,
+                       required, actual, bool(actual >= required - 1e-9), iso.formula, where, tuple(entries), ep,
+                       True)
+
+
+def _entries_to_zone(prims, covers, zone: HazardZone, t_ep: float):
+    """(every entry segment of the primitives with its distance to the zone, the least distance, where it is,
+    the least distance to the part of the zone swept during one episode)."""
+    entries, best, ep = [], (math.inf, None), math.inf
+    for prim in prims:
+        for q0, q1 in _entry_segments(prim, covers):
             dist, p, hp, k = segment_to_zone(q0, q1, zone)
             entries.append((q0, q1, dist))
             if dist < best[0]:
                 best = (dist, closest_on_zone(zone, p, hp, k))
             ep = min(ep, segment_to_zone(q0, q1, zone, t_ep)[0])
-    actual, where = best
-    required = iso.S / 1000.0
-    return DeviceCheck(chans[0].name, f"{d.type} warning field", d.response_time, stop, iso.T, iso.K, iso.C,
-                       required, actual, bool(actual >= required - 1e-9), iso.formula, where, tuple(entries), ep,
-                       True)
+    return entries, best[0], best[1], ep
 
 
 def _entry_segments(prim, covers) -> list[tuple[tuple[float, float], tuple[float, float]]]:
