@@ -81,6 +81,15 @@ def atomic_write_text(path: Path, text: str) -> None:
     atomic_write(path, text.encode("utf-8"))
 
 
+def write_in_folder(folder: str | Path, name: str, text: str) -> Path:
+    """Write ``folder/name`` atomically (the folder made if missing); returns its path."""
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / name
+    atomic_write_text(path, text)
+    return path
+
+
 def _umask() -> int:
     # os.umask can only be read by setting it; set it back at once (a process-wide value, read here only)
     mask = os.umask(0o022)

@@ -19,7 +19,7 @@ from pydantic import ConfigDict, Field, TypeAdapter, ValidationError, model_seri
 
 from cellstress.core import registry
 from cellstress.core.fields import Record
-from cellstress.core.io import InputFileError, atomic_write, canonical_json, json_ready, read_input_bytes
+from cellstress.core.io import InputFileError, canonical_json, json_ready, read_input_bytes, write_in_folder
 from cellstress.searchers.common import UNTIL, SearchError
 from cellstress.sim.records import Name, StepRecord
 
@@ -210,11 +210,7 @@ class SearchResult(Record):
 
     def write(self, out_dir: str | Path) -> Path:
         """Write ``out_dir/result.json`` atomically; returns its path."""
-        out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
-        path = out / FILE_NAME
-        atomic_write(path, self.to_json().encode("utf-8"))
-        return path
+        return write_in_folder(out_dir, FILE_NAME, self.to_json())
 
     @classmethod
     def load(cls, path: str | Path) -> SearchResult:

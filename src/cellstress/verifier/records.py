@@ -10,7 +10,7 @@ from typing import Annotated, Literal
 from pydantic import Field
 
 from cellstress.core.fields import Record
-from cellstress.core.io import atomic_write, canonical_json, json_ready
+from cellstress.core.io import canonical_json, json_ready, write_in_folder
 from cellstress.searchers.result import CellRef, HazardClass
 from cellstress.sim.records import Name
 
@@ -108,8 +108,4 @@ class VerifyResult(Record):
 
     def write(self, out_dir: str | Path) -> Path:
         """Write ``out_dir/verify.json`` atomically; returns its path."""
-        out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
-        path = out / FILE_NAME
-        atomic_write(path, self.to_json().encode("utf-8"))
-        return path
+        return write_in_folder(out_dir, FILE_NAME, self.to_json())
