@@ -7,7 +7,9 @@ empty CELLSTRESS_CACHE) and times, one after the other: the imports of the comma
 worker's reach field (built on the first run, then read from its cache), the simulator's set-up for the cell,
 the search, and the report. For each phase it prints the wall time and the part of it numba spent compiling
 (from numba's ``numba:compile`` events). ``--warm`` runs the same again with the caches the first run left,
-as every later run sees them. Run it on an idle machine; the first line says how many cores it had.
+as every later run sees them. The kernels compiled ahead and shipped with the package (cellstress.core.jit)
+are used as on a user's machine; ``--no-shipped`` switches them off to time numba compiling everything (what
+a user of another numba or Python waits). Run it on an idle machine; the first line says how many cores it had.
 """
 
 from __future__ import annotations
@@ -50,8 +52,11 @@ print(json.dumps({"phases": phases, "episodes": result.episodes, "found": result
 """
 
 
-def run(cell: str, searcher: str, budget: int, numba_dir: str, cache_dir: str) -> dict:
-    env = dict(os.environ, NUMBA_CACHE_DIR=numba_dir, CELLSTRESS_CACHE=cache_dir)
+def run(cell: str, searcher: str, budget: int, numba_dir: str, cache_dir: str, shipped: bool) -> dict:
+    env = dict(os.environ, NUMBA_CACHE_DIR=numba_dir, CELLSTRESS_CACHE=cache_dir,
+               CELLSTRESS_SHIPPED_KERNELS="1" if shipped else "0")
+    for name in ("NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES"):  # as on a fresh machine: the package chooses
+        env.pop(name, None)
     with tempfile.TemporaryDirectory() as out:
         p = subprocess.run([sys.executable, "-c", CHILD, cell, searcher, str(budget), out], env=env,
                            capture_output=True, text=True, check=False)
@@ -75,13 +80,17 @@ def main() -> None:
     ap.add_argument("--searcher", default="plan")
     ap.add_argument("--budget", type=int, default=200)
     ap.add_argument("--warm", action="store_true", help="run again with the caches of the first run")
+    ap.add_argument("--no-shipped", action="store_true", help="switch off the kernels shipped compiled")
     args = ap.parse_args()
-    print(f"{os.cpu_count()} cores; cell {args.cell}, searcher {args.searcher}, budget {args.budget}")
+    print(f"{os.cpu_count()} cores; cell {args.cell}, searcher {args.searcher}, budget {args.budget}; "
+          f"shipped kernels {'off' if args.no_shipped else 'on'}")
+    shipped = not args.no_shipped
     with tempfile.TemporaryDirectory() as numba_dir, tempfile.TemporaryDirectory() as cache_dir:
-        show("cold (empty caches)", run(args.cell, args.searcher, args.budget, numba_dir, cache_dir))
+        show("cold (empty caches)", run(args.cell, args.searcher, args.budget, numba_dir, cache_dir,
+                                                   shipped))
         if args.warm:
             show("warm (the caches of the cold run)", run(args.cell, args.searcher, args.budget, numba_dir,
-                                                           cache_dir))
+                                                           cache_dir, shipped))
 
 
 if __name__ == "__main__":

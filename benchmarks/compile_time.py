@@ -3,9 +3,10 @@
     python benchmarks/compile_time.py [--src SRC] [--repeat N]
 
 Each repeat runs a fresh interpreter with an empty NUMBA_CACHE_DIR (numba's cache for ``cache=True``
-functions goes there instead of ``__pycache__`` when it is set, so nothing is loaded from an earlier run) and
-does what a user's first search does: build a cell, run a batch, one whole episode and one step, and the
-plan searcher's worker-only kernels. It prints the wall time of each stage and, from numba's
+functions goes there instead of ``__pycache__`` when it is set, so nothing is loaded from an earlier run)
+and the shipped kernel cache switched off (``CELLSTRESS_SHIPPED_KERNELS=0``, cellstress.core.jit), and does
+what a user's first search does: build a cell, run a batch, one whole episode and one step, and the plan
+searcher's worker-only kernels. It prints the wall time of each stage and, from numba's
 ``numba:compile`` events, every function that was compiled with its own time (excluding the functions
 compiled inside it) and its time including them. ``--src`` runs another checkout's sources (e.g. an older
 tree from ``git archive``).
@@ -61,6 +62,7 @@ def one_run(src: str | None) -> dict:
         env["PYTHONPATH"] = src + os.pathsep + env.get("PYTHONPATH", "")
     with tempfile.TemporaryDirectory() as cache:
         env["NUMBA_CACHE_DIR"] = cache
+        env["CELLSTRESS_SHIPPED_KERNELS"] = "0"  # compile: measure numba, not the shipped cache (core/jit.py)
         out = subprocess.run([sys.executable, "-c", CHILD], env=env, check=True, capture_output=True, text=True).stdout
     return json.loads(out.strip().splitlines()[-1])
 

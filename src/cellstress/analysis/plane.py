@@ -7,7 +7,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from cellstress.core.jit import njit
 
 JOIN_EXT = 1e-4  # m, panels meeting at a vertex are lengthened by this so no line slips through the joint
 NODE_OFF = 1e-3  # m, detour nodes sit this far off a fence end or outer corner

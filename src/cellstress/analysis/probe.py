@@ -14,8 +14,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from cellstress.core.jit import njit
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator

@@ -54,7 +54,7 @@ def _exit_with_parent() -> None:
 def set_threads(threads: int | None) -> None:
     if threads is None:
         return
-    import numba
+    from cellstress.core.jit import numba
 
     # numba's thread count is per calling thread; workers run their tasks on the thread that calls this
     if numba.get_num_threads() != threads:

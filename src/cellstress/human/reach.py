@@ -22,9 +22,9 @@ from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
-from numba import njit
 
 from cellstress.core.io import atomic_write
+from cellstress.core.jit import njit
 
 # Ranges of motion [deg] (AAOS normal values): flexion 180 / extension 60, abduction 180 / adduction 30,
 # internal rotation 70 / external rotation 90, elbow flexion 0..150, wrist flexion 80 / extension 70.

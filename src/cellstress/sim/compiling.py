@@ -13,7 +13,7 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-from numba.core import event
+from cellstress.core.jit import event
 
 
 class CompileWatch(event.Listener):

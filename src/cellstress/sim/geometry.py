@@ -6,8 +6,8 @@ Every function works on plain floats and arrays so numba compiles it into the si
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
-from numba.core.cpu import CPUTargetOptions
+
+from cellstress.core.jit import CPUTargetOptions, njit
 
 EPS = 1e-12
 

@@ -34,8 +34,8 @@ The gap does: only the second has a moving robot within reach inside the window.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from cellstress.core.jit import njit
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 

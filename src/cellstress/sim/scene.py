@@ -8,8 +8,8 @@ so a picture shows exactly what the simulator measured. Nothing here is on the h
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from cellstress.core.jit import njit
 from cellstress.human.body import N_CAPSULES, BodyPose
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L

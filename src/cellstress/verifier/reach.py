@@ -28,8 +28,8 @@ least of those values over the samples of path times [tau0 + k dt, tau0 + k' dt]
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
 
+from cellstress.core.jit import njit, prange
 from cellstress.sim import layout as L
 from cellstress.sim.scene import robot_capsules
 

@@ -117,7 +117,7 @@ def decide_task(task: Task, progress: Callable[[int], None] | None = None) -> De
 def _init_worker() -> None:
     import signal
 
-    import numba
+    from cellstress.core.jit import numba
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the main process handles Ctrl-C and stops the pool
     numba.set_num_threads(1)  # one thread per worker process: N workers on N cores

@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
-from numba.typed import List
 
+from cellstress.core.jit import List, njit, prange
 from cellstress.sim.geometry import NO_REFCOUNT
 from cellstress.sim.kernels.params import make_work
 from cellstress.sim.kernels.step import sense_and_measure, step_action

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from cellstress.core.jit import njit
 from cellstress.sim.layout import (
     B_ARM_LEN,
     B_HEAD_RISE,

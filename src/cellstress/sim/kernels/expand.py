@@ -8,8 +8,8 @@ A child is exactly what ``step_action`` makes of its parent: the same compiled s
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
 
+from cellstress.core.jit import njit, prange
 from cellstress.sim.geometry import NO_REFCOUNT
 from cellstress.sim.kernels.params import make_work
 from cellstress.sim.kernels.step import step_action

@@ -4,8 +4,8 @@ shortest way round them (over the top edge or around an end) with a lower bound 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from cellstress.core.jit import njit
 from cellstress.sim.geometry import NO_REFCOUNT, point_segment_2d
 
 

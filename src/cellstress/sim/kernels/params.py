@@ -6,8 +6,8 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
+from cellstress.core.jit import njit
 from cellstress.sim.layout import N_BODY_CAPSULES
 
 

@@ -8,8 +8,8 @@ here it is placed on the posed shoulders and combined with the fences.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from cellstress.core.jit import njit
 from cellstress.human.reach import reach_lookup
 from cellstress.sim.kernels.fences import blocking_panel, fence_detour, fence_detour_bound
 from cellstress.sim.layout import B_ARM_LEN, C_REACH_H, C_REACH_ORIGIN

@@ -15,8 +15,8 @@ form (``live_path_time``), so the robot is still a pure function of the state an
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from cellstress.core.jit import njit
 from cellstress.sim.geometry import NO_REFCOUNT
 from cellstress.sim.kernels.params import make_work
 from cellstress.sim.layout import (

@@ -4,8 +4,8 @@ can stand (floor, table, fences) and lean (no trunk through a fence)."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from cellstress.core.jit import njit
 from cellstress.human.body import WALK_BLOCK_HEIGHT
 from cellstress.sim.geometry import (
     NO_REFCOUNT,

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from cellstress.core.jit import njit
 from cellstress.sim.geometry import segment_segment_xyz
 from cellstress.sim.kernels.reach import fenced_reach, reach_field_at, reach_to_segment
 from cellstress.sim.layout import (

@@ -9,8 +9,8 @@ without reference counting (``geometry.NO_REFCOUNT``).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from cellstress.core.jit import njit
 from cellstress.sim.geometry import NO_REFCOUNT, segment_segment_xyz
 from cellstress.sim.kernels.body import pose_body
 from cellstress.sim.kernels.fences import collect_near_fences
