@@ -99,22 +99,36 @@ def _mark_segment(grid, origin, h, ax, ay, az, bx, by, bz):
 
 
 @njit(cache=True)
-def _rasterise(grid, origin, h, lengths, qs):
+def _rasterise(grid, origin, h, lengths, a0, a1, a2, a3, a4):
+    """Mark every voxel the arm's three segments cross, for every combination of the five joints' samples (a
+    grid of joint space walked in place: as an array it would take ~250 MB at the coarse step)."""
     pts = np.empty((3, 3))
     rot = np.empty((3, 3))
-    for i in range(qs.shape[0]):
-        arm_points_into(qs[i], lengths, rot, pts)
-        _mark_segment(grid, origin, h, 0.0, 0.0, 0.0, pts[0, 0], pts[0, 1], pts[0, 2])
-        _mark_segment(grid, origin, h, pts[0, 0], pts[0, 1], pts[0, 2], pts[1, 0], pts[1, 1], pts[1, 2])
-        _mark_segment(grid, origin, h, pts[1, 0], pts[1, 1], pts[1, 2], pts[2, 0], pts[2, 1], pts[2, 2])
+    q = np.empty(5)
+    for i0 in range(a0.shape[0]):
+        q[0] = a0[i0]
+        for i1 in range(a1.shape[0]):
+            q[1] = a1[i1]
+            for i2 in range(a2.shape[0]):
+                q[2] = a2[i2]
+                for i3 in range(a3.shape[0]):
+                    q[3] = a3[i3]
+                    for i4 in range(a4.shape[0]):
+                        q[4] = a4[i4]
+                        arm_points_into(q, lengths, rot, pts)
+                        _mark_segment(grid, origin, h, 0.0, 0.0, 0.0, pts[0, 0], pts[0, 1], pts[0, 2])
+                        _mark_segment(grid, origin, h, pts[0, 0], pts[0, 1], pts[0, 2],
+                                      pts[1, 0], pts[1, 1], pts[1, 2])
+                        _mark_segment(grid, origin, h, pts[1, 0], pts[1, 1], pts[1, 2],
+                                      pts[2, 0], pts[2, 1], pts[2, 2])
 
 
-def _joint_samples(step_deg: tuple[float, float, float, float, float]) -> np.ndarray:
+def _joint_axes(step_deg: tuple[float, float, float, float, float]) -> list[np.ndarray]:
+    """Each joint's samples [rad]: its range at the given step, always with both ends."""
     axes = [np.deg2rad(np.arange(lo, hi + 1e-9, s)) for (lo, hi), s in zip(JOINT_RANGES_DEG, step_deg, strict=True)]
     for ax, (_lo, hi) in zip(axes, np.deg2rad(JOINT_RANGES_DEG), strict=True):
         ax[-1] = hi  # always include the range ends
-    mesh = np.meshgrid(*axes, indexing="ij")
-    return np.stack([m.ravel() for m in mesh], axis=1)
+    return axes
 
 
 # The lookup the simulator's kernels inline into their hot loop (and ReachField.distance calls): it is the
@@ -182,10 +196,9 @@ def _build(lengths: tuple[float, float, float], spacing: float) -> ReachField:
     # arm reaches furthest) at a step fine enough to leave no gap wider than a voxel at full reach.
     # Upper-arm rotation swings the bent forearm and hand (up to 0.5 m from its axis): a 20 deg step left
     # holes of up to 2.5 voxels in the surface that the closing below cannot fill; 10 deg leaves none.
-    _rasterise(occupied, origin, spacing, lengths_arr, _joint_samples((6.0, 6.0, 10.0, 10.0, 10.0)))
+    _rasterise(occupied, origin, spacing, lengths_arr, *_joint_axes((6.0, 6.0, 10.0, 10.0, 10.0)))
     fine = np.rad2deg(spacing / reach) * 0.9
-    shell = _joint_samples((fine, fine, 200.0, 200.0, 200.0))
-    _rasterise(occupied, origin, spacing, lengths_arr, shell)
+    _rasterise(occupied, origin, spacing, lengths_arr, *_joint_axes((fine, fine, 200.0, 200.0, 200.0)))
     occupied = ndimage.binary_closing(occupied, structure=np.ones((3, 3, 3)), iterations=1)
     occupied = ndimage.binary_fill_holes(occupied)
     outside = ndimage.distance_transform_edt(~occupied, sampling=spacing)
