@@ -43,8 +43,9 @@ from cellstress.analysis.plane import (
     rasterise_zone,
 )
 from cellstress.cell.load import Cell, load_cell
-from cellstress.core.records import ScanPlane, VerticalField
+from cellstress.core.records import DoorLeaf, ScanPlane, VerticalField
 from cellstress.devices.base import DeviceRecord
+from cellstress.devices.guard_door import GuardDoor
 from cellstress.human.body import WALK_BLOCK_HEIGHT
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
@@ -77,6 +78,7 @@ class DeviceCheck:
     # from the cell's phase): what a search can actually meet; for information, ISO uses the whole cycle
     episode_actual: float = math.inf
     field_edges: bool = False  # the entries are the open edges of a scan plane's field (listed one by one)
+    note: str = ""  # a further line of the device kind's own (a guard door: its access time, ISO 14119)
 
 
 @dataclass(frozen=True)
@@ -203,9 +205,10 @@ def _device_checks(spec, zone: HazardZone) -> tuple[DeviceCheck, ...]:
         iso = d.required_distance(stop)
         entries, actual, where, ep = _entries_to_zone(d.primitives(), covers, zone, t_ep)
         required = iso.S / 1000.0
+        note = d.access_note(actual, stop) if isinstance(d, GuardDoor) else ""
         out.append(DeviceCheck(d.name, d.type, d.response_time, stop, iso.T, iso.K, iso.C, required,
                                actual, bool(actual >= required - 1e-9), iso.formula, where,
-                               tuple(entries), ep, any(isinstance(p, ScanPlane) for p in d.primitives())))
+                               tuple(entries), ep, any(isinstance(p, ScanPlane) for p in d.primitives()), note))
         warn = d.warning_distance(stop) if isinstance(d, DeviceRecord) else None
         if warn is not None:  # the warning field: measured like a field, against its own distance
             out.append(_warning_check(d, warn, stop, covers, zone, t_ep))
@@ -241,7 +244,7 @@ def _entry_segments(prim, covers) -> list[tuple[tuple[float, float], tuple[float
     if isinstance(prim, ScanPlane):
         poly = prim.polygon
         return [seg for i in range(len(poly)) for seg in open_intervals(poly[i], poly[(i + 1) % len(poly)], covers)]
-    if isinstance(prim, VerticalField):
+    if isinstance(prim, VerticalField | DoorLeaf):  # (a door: its opening)
         return [(tuple(prim.start), tuple(prim.end))]
     raise TypeError(f"unknown detection primitive {type(prim).__name__}")
 
@@ -441,6 +444,8 @@ def _lines(r: StaticCheck) -> list[str]:
         if r.phase_fixed and math.isfinite(d.episode_actual) and d.episode_actual > d.actual + 5e-4:
             out.append(f"    (during one episode, t = 0..{r.episode:.2f} s from the cell's phase, "
                        f"the robot comes no closer than {d.episode_actual:.3f} m)")
+        if d.note:
+            out.append(f"  {d.note}")
     closed = [p for p in r.fences if p.closed]
     open_ = [p for p in r.fences if not p.closed]
     if closed:

@@ -26,11 +26,16 @@ def safeguard_words(layout, records, unsafe_row: int) -> str | None:
     warn = {names[i]: (float(P.dev_speed[i]), float(P.dev_resp[i])) for i in range(len(names))
             if P.dev_speed[i] != 0.0}
     stop_names = {names[i] for i in range(len(names)) if P.dev_speed[i] == 0.0}
+    doors = {names[int(d)]: (float(P.door_open[i]), P.door_lock[i] != 0.0) for i, d in enumerate(P.door_dev)}
     parts, seen_warn = [], set()
     last_stop_seen: tuple[str, float] | None = None
     prev = None
+    first_stop = min((r.t + float(P.dev_resp[names.index(n)]) for r in records[: unsafe_row + 1] for n in r.devices
+                      if n in stop_names), default=None)
     for r in records[: unsafe_row + 1]:
         for name in r.devices:
+            if name in doors and (prev is None or name not in prev.devices):
+                parts.append(_door_words(name, *doors[name], r.t, first_stop, layout))
             if name in warn and name not in seen_warn:
                 seen_warn.add(name)
                 frac, resp = warn[name]
@@ -48,6 +53,18 @@ def safeguard_words(layout, records, unsafe_row: int) -> str | None:
         return None
     hit = records[unsafe_row]
     return "; ".join(parts) + f"; v_R at the contact {hit.v_R:.2f} m/s ({hit.stop_phase})"
+
+
+def _door_words(name: str, opening: float, locked: bool, pushed: float, first_stop: float | None, layout) -> str:
+    """A guard door's part of the timeline: when it was pushed, when it let the worker through, and how that
+    compares with the robot's rest (its first stop plus the stopping time)."""
+    rest = None if first_stop is None else _r(first_stop + float(layout.cell.spec.robot.stopping_time))
+    if locked:
+        return f"{name} was pushed at {pushed:.2f} s and stayed locked until the robot was at rest ({rest:.2f} s)"
+    through = _r(pushed + opening)
+    gap = "" if rest is None else (f", {rest - through:.2f} s before the robot was at rest ({rest:.2f} s)"
+                                   if rest > through else f", the robot at rest since {rest:.2f} s")
+    return f"{name} opened at {pushed:.2f} s without guard locking and let the worker through from {through:.2f} s{gap}"
 
 
 def explain(layout, records, unsafe_row: int) -> Why:

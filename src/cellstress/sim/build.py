@@ -11,7 +11,7 @@ from cellstress.cell.load import Cell
 from cellstress.cell.program import held_joints, robot_program
 from cellstress.cell.schema import ObstacleSpec
 from cellstress.core.protocols import Channels
-from cellstress.core.records import Channel, ScanPlane, VerticalField
+from cellstress.core.records import MAX_DOORS, Channel, DoorLeaf, ScanPlane, VerticalField
 from cellstress.human.actions import action_table
 from cellstress.human.body import BodyDimensions
 from cellstress.human.reach import ReachField, reach_field
@@ -22,7 +22,7 @@ from cellstress.robot.trajectory import Trajectory
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 
-SCANNER, CURTAIN = L.DEV_SCANNER, L.DEV_CURTAIN  # detection primitive kinds in the kernel
+SCANNER, CURTAIN, DOOR = L.DEV_SCANNER, L.DEV_CURTAIN, L.DEV_DOOR  # detection primitive kinds in the kernel
 
 
 @dataclass(frozen=True)
@@ -74,6 +74,10 @@ def _channel(d, prim, kinds, rects, polys) -> None:
         kinds.append(SCANNER)
         rects.append((0.0, 0.0, 0.0, 0.0, prim.height, prim.height))
         polys.append(prim.polygon)
+    elif isinstance(prim, DoorLeaf):
+        kinds.append(DOOR)
+        rects.append((*prim.start, *prim.end, prim.bottom, prim.top))
+        polys.append(())
     elif isinstance(prim, VerticalField):
         kinds.append(CURTAIN)
         rects.append((*prim.start, *prim.end, prim.bottom, prim.top))
@@ -96,6 +100,14 @@ class Layout:
     params: K.SimParams
     joints: JointMap  # the joints the program drives; the others are held or mimic ones
     obstacles: tuple[ObstacleSpec, ...] = ()  # the table's polygons, the cell's obstacles, the robot's pedestal
+
+    @property
+    def static_fences(self) -> bool:
+        """True when the cell has no guard door: every fence panel blocks for the whole episode. A door's leaf
+        blocks until it opens (its state slots say when). The verifier's bounds ignore fences altogether (they
+        only shorten the worker's reach and walk), so they hold either way; whatever assumes fixed panels asks
+        this."""
+        return self.params.door_dev.shape[0] == 0
 
     @property
     def stops_latch(self) -> bool:
@@ -162,6 +174,13 @@ def build_layout(cell: Cell) -> Layout:
     obs_verts, obs_poly, obs_box = obstacle_arrays(obstacles)
 
     dev = device_arrays(spec.devices)
+    doors = [d for d in range(len(dev.kind)) if dev.kind[d] == DOOR]
+    if len(doors) > MAX_DOORS:  # (the cell schema refuses such a cell first)
+        raise ValueError(f"{len(doors)} guard doors; the simulator takes at most {MAX_DOORS}")
+    door_leaves = [p for d in spec.devices for p in d.primitives() if isinstance(p, DoorLeaf)]
+    # a door's leaf is a fence panel after the fences' own while it is closed (kernels.doors)
+    door_fence = [len(fences) + i for i in range(len(doors))]
+    fences += [tuple(dev.rect[d]) for d in doors]
 
     scal = np.zeros(L.N_SCAL)
     scal[L.C_DT] = spec.simulation.dt
@@ -209,6 +228,10 @@ def build_layout(cell: Cell) -> Layout:
         dev_verts=dev.verts,
         dev_speed=dev.speed,
         dev_clear=dev.clear,
+        door_dev=np.asarray(doors, dtype=np.int64),
+        door_fence=np.asarray(door_fence, dtype=np.int64),
+        door_open=np.asarray([p.opening_time for p in door_leaves], dtype=float),
+        door_lock=np.asarray([1.0 if p.guard_locking else 0.0 for p in door_leaves], dtype=float),
         pre_ra=np.zeros((0, len(caps), 3)),
         pre_rb=np.zeros((0, len(caps), 3)),
         pre_v=np.zeros(0),
