@@ -41,7 +41,8 @@ class GuardDoor(DeviceRecord):
     top: Height = 2.0
     """Height of the leaf's upper edge [m]."""
     response_time: PositiveTime = 0.05
-    """Time [s] from the door's first movement to the interlock's stop signal."""
+    """Time [s] from the push (the leaf's first movement; with guard locking the request to enter) to the
+    interlock's stop signal."""
     opening_time: PositiveTime = 0.6
     """Time [s] from the push until the leaf is open wide enough for a person to pass (with guard locking:
     from the unlocking)."""

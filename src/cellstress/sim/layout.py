@@ -69,11 +69,13 @@ STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
       for i in range(MAX_DOORS)),
 ))
 (S_K, S_X, S_Y, S_HEADING, S_FWD, S_LAT, S_TSTOP, S_TRIG_DEV, S_TRIG_T, S_UNSAFE, S_ACTIONS, S_LIVE, S_A_T, S_A_TAU,
- S_A_SIG, S_A_TGT, S_TSLOW, S_SLOW, S_STOP_SEEN, S_STOP_CLEAR, S_SLOW_SEEN, S_SLOW_CLEAR, S_RESTARTS) = STATE.indices(
+ S_A_SIG, S_A_TGT, S_TSLOW, S_SLOW, S_STOP_SEEN, S_STOP_CLEAR, S_SLOW_SEEN, S_SLOW_CLEAR, S_RESTARTS,
+ S_DOOR0_REQ, S_DOOR1_REQ, S_DOOR2_REQ, S_DOOR3_REQ, S_DOOR0_OPEN, S_DOOR1_OPEN, S_DOOR2_OPEN,
+ S_DOOR3_OPEN) = STATE.indices(
     "K", "X", "Y", "HEADING", "FWD", "LAT", "TSTOP", "TRIG_DEV", "TRIG_T", "UNSAFE", "ACTIONS", "LIVE", "A_T", "A_TAU",
     "A_SIG", "A_TGT", "TSLOW", "SLOW", "STOP_SEEN", "STOP_CLEAR", "SLOW_SEEN", "SLOW_CLEAR", "RESTARTS",
-    *_DOOR_SLOTS)[:23]
-S_DOOR_REQ, S_DOOR_OPEN = STATE.index("DOOR0_REQ"), STATE.index("DOOR0_OPEN")  # door i's slots: these + i
+    *_DOOR_SLOTS)
+S_DOOR_REQ, S_DOOR_OPEN = S_DOOR0_REQ, S_DOOR0_OPEN  # door i's slots: these + i (the kernels index by door)
 NS = STATE.size
 
 ROW = VectorSpec("metric row (one per time step; row 0 of an episode is its start)", (
