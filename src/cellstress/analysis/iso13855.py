@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from cellstress.analysis.hazard_zone import Closest, HazardZone, closest_on_zone, hazard_zone, segment_to_zone
+from cellstress.analysis.muting import muting_checks
 from cellstress.analysis.plane import (
     closest_reach,
     detour_nodes,
@@ -122,17 +123,19 @@ class StaticCheck:
     episode: float  # s, length of one search episode
     phase_fixed: bool = True  # the worker arrives at the cell's own phase (human.arrival: fixed)
     restarts: tuple = ()  # RestartCheck of every device with an automatic restart
+    mutings: tuple = ()  # analysis.muting.MutingCheck of every muted light curtain
 
     @property
     def ok(self) -> bool:
-        return all(d.ok for d in self.devices) and self.approach.ok and all(r.ok for r in self.restarts)
+        return all(d.ok for d in self.devices) and self.approach.ok and all(r.ok for r in self.restarts + self.mutings)
 
     def failures(self) -> list[str]:
-        """Names of the failed checks: device names, 'undetected-reach' and/or 'DEVICE-restart'."""
+        """Names of the failed checks: device names, 'undetected-reach', 'DEVICE-restart', 'DEVICE-muting'."""
         out = [d.device for d in self.devices if not d.ok]
         if not self.approach.ok:
             out.append("undetected-reach")
         out += [f"{r.device}-restart" for r in self.restarts if not r.ok]
+        out += [f"{m.device}-muting" for m in self.mutings if not m.ok]
         return out
 
     def lines(self) -> list[str]:
@@ -398,7 +401,7 @@ def check_cell(cell: Cell | str | Path, layout=None) -> StaticCheck:
     approach = _approach_check(spec, layout, zone, panels, lean, ARM_ALLOWANCE)
     return StaticCheck(spec.name, zone, devices, approach, panels, shoulder, float(body[L.B_ARM_LEN]),
                        episode_length(spec), spec.human.arrival == "fixed",
-                       _restart_checks(spec, layout, zone, panels, lean))
+                       _restart_checks(spec, layout, zone, panels, lean), muting_checks(spec))
 
 
 def device_distances(cell: Cell | str | Path, layout=None) -> list[DeviceCheck]:
@@ -479,6 +482,7 @@ def _lines(r: StaticCheck) -> list[str]:
             out.append(f"  closest: stand at {_xy(b.stand)}, shoulder at {_xy(b.where.point)}, arm path "
                        f"{b.distance:.3f} m >= {b.arm_allowance:.2f} m? {_verdict(rc.ok)}{_where(b.where, z.cycle)}"
                        + ("" if rc.ok else ": the robot restarts while the worker stands unseen within reach"))
+    out += [m.line() for m in r.mutings]
     fails = r.failures()
     out.append("result: pass" if not fails else f"result: FAIL ({', '.join(fails)})")
     return out

@@ -99,6 +99,20 @@ Primitive = ScanPlane | VerticalField | DoorLeaf
 
 
 @dataclass(frozen=True)
+class TimedPanel:
+    """A panel over the floor segment ``start``-``end`` from ``bottom`` to ``top`` [m] that blocks like a fence
+    panel only while the cell's clock, (phase + t) modulo the robot's cycle, lies in [``t_in``, ``t_out``] [s]:
+    a pallet filling a conveyor opening as it passes."""
+
+    start: Point2
+    end: Point2
+    bottom: float
+    top: float
+    t_in: float
+    t_out: float
+
+
+@dataclass(frozen=True)
 class Channel:
     """One detection primitive of a device and what its detection does (what the kernel senses): ``speed`` 0
     stops the robot, a fraction in (0, 1) cuts it to that fraction of its path speed (a warning field);
@@ -110,6 +124,8 @@ class Channel:
     speed: float
     response_time: float
     clear_time: float
+    # muted (sees nothing) while the cell's clock, (phase + t) modulo the robot's cycle, lies in [on, off] [s]
+    muted: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)

@@ -9,6 +9,7 @@ static check.
 from __future__ import annotations
 
 from cellstress.searchers.result import DeviceTiming, Why
+from cellstress.sim import layout as L
 
 
 def _r(t: float) -> float:
@@ -32,6 +33,7 @@ def safeguard_words(layout, records, unsafe_row: int) -> str | None:
     prev = None
     first_stop = min((r.t + float(P.dev_resp[names.index(n)]) for r in records[: unsafe_row + 1] for n in r.devices
                       if n in stop_names), default=None)
+    parts += _muting_words(layout, records[: unsafe_row + 1])
     for r in records[: unsafe_row + 1]:
         for name in r.devices:
             if name in doors and (prev is None or name not in prev.devices):
@@ -53,6 +55,24 @@ def safeguard_words(layout, records, unsafe_row: int) -> str | None:
         return None
     hit = records[unsafe_row]
     return "; ".join(parts) + f"; v_R at the contact {hit.v_R:.2f} m/s ({hit.stop_phase})"
+
+
+def _muting_words(layout, records) -> list[str]:
+    """Each muted channel's muting during the episode up to the contact, from the cell's clock."""
+    P = layout.params
+    phase, cycle = float(P.scal[L.C_PHASE0]), float(P.scal[L.C_CYCLE])
+    out = []
+    for d, name in enumerate(layout.device_names):
+        on, off = float(P.dev_muted[d, 0]), float(P.dev_muted[d, 1])
+        if on == float("inf"):
+            continue
+        times = [r.t for r in records if on <= (phase + r.t) % cycle <= off or on <= (phase + r.t) % cycle + cycle
+                 <= off]
+        if times:
+            still = " (still muted at the contact)" if times[-1] == records[-1].t else ""
+            out.append(f"{name} was muted from {times[0]:.2f} s to {times[-1]:.2f} s ({on:g}..{off:g} s of the "
+                       f"cycle){still}")
+    return out
 
 
 def _door_words(name: str, opening: float, locked: bool, pushed: float, first_stop: float | None, layout) -> str:

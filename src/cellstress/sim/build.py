@@ -10,7 +10,7 @@ import numpy as np
 from cellstress.cell.load import Cell
 from cellstress.cell.program import held_joints, robot_program
 from cellstress.cell.schema import ObstacleSpec
-from cellstress.core.protocols import Channels
+from cellstress.core.protocols import Channels, TimedPanels
 from cellstress.core.records import MAX_DOORS, Channel, DoorLeaf, ScanPlane, VerticalField
 from cellstress.human.actions import action_table
 from cellstress.human.body import BodyDimensions
@@ -38,6 +38,7 @@ class DeviceArrays:
     names: tuple[str, ...]
     speed: np.ndarray  # (nd,) 0: the channel stops the robot; else the reduced speed's fraction
     clear: np.ndarray  # (nd,) s without detection before its stop or reduction is released; inf: manual
+    muted: np.ndarray  # (nd, 2) clock window [on, off] in which the channel sees nothing; (inf, inf): never
 
 
 def pack_polygons(polys) -> tuple[np.ndarray, np.ndarray]:
@@ -51,7 +52,7 @@ def pack_polygons(polys) -> tuple[np.ndarray, np.ndarray]:
 
 def device_arrays(devices) -> DeviceArrays:
     """The kernel's arrays of the cell's devices, from each device's detection primitive."""
-    kinds, resp, rects, polys, names, speed, clear = [], [], [], [], [], [], []
+    kinds, resp, rects, polys, names, speed, clear, muted = [], [], [], [], [], [], [], []
     for d in devices:
         chans = d.channels() if isinstance(d, Channels) else \
             tuple(Channel(p, d.name, 0.0, d.response_time, np.inf) for p in d.primitives())
@@ -63,10 +64,12 @@ def device_arrays(devices) -> DeviceArrays:
             names.append(c.name)
             speed.append(c.speed)
             clear.append(c.clear_time)
+            muted.append((np.inf, np.inf) if c.muted is None else c.muted)
     verts, index = pack_polygons(polys)
     return DeviceArrays(np.asarray(kinds, dtype=np.int64), np.asarray(resp, dtype=float),
                         np.asarray(rects, dtype=float).reshape(-1, 6), index, verts, tuple(names),
-                        np.asarray(speed, dtype=float), np.asarray(clear, dtype=float))
+                        np.asarray(speed, dtype=float), np.asarray(clear, dtype=float),
+                        np.asarray(muted, dtype=float).reshape(-1, 2))
 
 
 def _channel(d, prim, kinds, rects, polys) -> None:
@@ -103,11 +106,11 @@ class Layout:
 
     @property
     def static_fences(self) -> bool:
-        """True when the cell has no guard door: every fence panel blocks for the whole episode. A door's leaf
-        blocks until it opens (its state slots say when). The verifier's bounds ignore fences altogether (they
-        only shorten the worker's reach and walk), so they hold either way; whatever assumes fixed panels asks
-        this."""
-        return self.params.door_dev.shape[0] == 0
+        """True when the cell has no guard door and no pallet: every fence panel blocks for the whole episode.
+        A door's leaf blocks until it opens (its state slots say when), a pallet while it passes. The verifier's
+        bounds ignore fences altogether (they only shorten the worker's reach and walk), so they hold either
+        way; whatever assumes fixed panels asks this."""
+        return self.params.door_dev.shape[0] == 0 and self.params.panel_fence.shape[0] == 0
 
     @property
     def stops_latch(self) -> bool:
@@ -181,6 +184,10 @@ def build_layout(cell: Cell) -> Layout:
     # a door's leaf is a fence panel after the fences' own while it is closed (kernels.doors)
     door_fence = [len(fences) + i for i in range(len(doors))]
     fences += [tuple(dev.rect[d]) for d in doors]
+    # timed panels (a muted curtain's pallet) after them: they block only within their clock windows
+    timed = [p for d in spec.devices if isinstance(d, TimedPanels) for p in d.timed_panels()]
+    panel_fence = [len(fences) + i for i in range(len(timed))]
+    fences += [(*p.start, *p.end, p.bottom, p.top) for p in timed]
 
     scal = np.zeros(L.N_SCAL)
     scal[L.C_DT] = spec.simulation.dt
@@ -232,6 +239,9 @@ def build_layout(cell: Cell) -> Layout:
         door_fence=np.asarray(door_fence, dtype=np.int64),
         door_open=np.asarray([p.opening_time for p in door_leaves], dtype=float),
         door_lock=np.asarray([1.0 if p.guard_locking else 0.0 for p in door_leaves], dtype=float),
+        dev_muted=dev.muted,
+        panel_fence=np.asarray(panel_fence, dtype=np.int64),
+        panel_win=np.asarray([(p.t_in, p.t_out) for p in timed], dtype=float).reshape(-1, 2),
         pre_ra=np.zeros((0, len(caps), 3)),
         pre_rb=np.zeros((0, len(caps), 3)),
         pre_v=np.zeros(0),

@@ -1,4 +1,5 @@
-"""Interlocked guard doors: when the worker pushes one, when it opens, and where its leaf blocks.
+"""Interlocked guard doors: when the worker pushes one, when it opens, and where its leaf blocks; and the
+panels that block on the cell's clock (a pallet passing a muted curtain's opening), and the muting itself.
 
 A door's leaf is a row of ``P.fences`` (``P.door_fence``). The kernels block with ``W.fences``, a copy of them in
 which ``place_doors`` moves the leaf of every passable door out of the way for the state at hand, so the fence
@@ -13,7 +14,7 @@ import numpy as np
 from numba import njit
 
 from cellstress.sim.geometry import point_segment_2d
-from cellstress.sim.layout import C_STOP_TIME, S_DOOR_OPEN, S_DOOR_REQ, S_TSTOP
+from cellstress.sim.layout import C_CYCLE, C_PHASE0, C_STOP_TIME, S_DOOR_OPEN, S_DOOR_REQ, S_TSTOP
 
 FAR = 1.0e6  # m: where a passable door's leaf is put: a point this far off is near nothing
 
@@ -42,16 +43,36 @@ def door_signals(P, state, d, t):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def on_clock(P, t, a, b):
+    """The cell's clock at t, (phase + t) modulo the robot's cycle, lies in [a, b] (b may run past the cycle's
+    end: the window then wraps to its start)."""
+    c = (P.scal[C_PHASE0] + t) % P.scal[C_CYCLE]
+    return (a <= c <= b) or (a <= c + P.scal[C_CYCLE] <= b)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def muted(P, d, t):
+    """Channel d is muted at t (it sees nothing): the cell's clock is in its muting window."""
+    return P.dev_muted[d, 0] < np.inf and on_clock(P, t, P.dev_muted[d, 0], P.dev_muted[d, 1])
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _place(P, fences, f, blocks):
+    if blocks:
+        for j in range(6):
+            fences[f, j] = P.fences[f, j]
+    else:
+        fences[f, 0] = fences[f, 1] = fences[f, 2] = fences[f, 3] = FAR
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def place_doors(P, state, fences, t):
     """``fences`` (a copy of P.fences) for the state at t: each door's leaf where it is while it blocks, a
-    point far off once it is passable."""
+    point far off once it is passable; each timed panel (a pallet) in place only within its clock window."""
     for i in range(P.door_fence.shape[0]):
-        f = P.door_fence[i]
-        if door_passable(P, state, i, t):
-            fences[f, 0] = fences[f, 1] = fences[f, 2] = fences[f, 3] = FAR
-        else:
-            for j in range(6):
-                fences[f, j] = P.fences[f, j]
+        _place(P, fences, P.door_fence[i], not door_passable(P, state, i, t))
+    for i in range(P.panel_fence.shape[0]):
+        _place(P, fences, P.panel_fence[i], on_clock(P, t, P.panel_win[i, 0], P.panel_win[i, 1]))
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -47,6 +47,9 @@ class SimParams(NamedTuple):
     door_fence: np.ndarray  # (n_doors,) int64: door i's leaf, a row of fences (blocks only while not passable)
     door_open: np.ndarray  # (n_doors,) opening time [s]: passable this long after it starts to open
     door_lock: np.ndarray  # (n_doors,) 1: guard locking (starts to open only once the robot is at rest)
+    dev_muted: np.ndarray  # (nd, 2) cell-clock window [on, off] in which channel d sees nothing; (inf, inf): never
+    panel_fence: np.ndarray  # (n_panels,) int64: timed panels (a pallet), rows of fences blocking only in a window
+    panel_win: np.ndarray  # (n_panels, 2) cell-clock window [in, out] in which timed panel i blocks
     pre_ra: np.ndarray  # (n_pre, nc, 3) robot capsules at step k before any stop (a cache: see robot_at)
     pre_rb: np.ndarray
     pre_v: np.ndarray  # (n_pre,) v_R

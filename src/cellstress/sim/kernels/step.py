@@ -13,7 +13,7 @@ from numba import njit
 
 from cellstress.sim.geometry import NO_REFCOUNT, segment_segment_xyz
 from cellstress.sim.kernels.body import pose_body
-from cellstress.sim.kernels.doors import door_signals, note_push, place_doors, push_doors, unlock_doors
+from cellstress.sim.kernels.doors import door_signals, muted, note_push, place_doors, push_doors, unlock_doors
 from cellstress.sim.kernels.fences import collect_near_fences
 from cellstress.sim.kernels.reach import reach_value_at
 from cellstress.sim.kernels.robot import live_path_time, robot_at
@@ -87,6 +87,8 @@ def sense_and_measure(P, state, W, row, action):
     seen = 0
     dev_kind, dev_rect, dev_poly, dev_verts, body = P.dev_kind, P.dev_rect, P.dev_poly, P.dev_verts, P.body
     for d in range(dev_kind.shape[0]):
+        if muted(P, d, t):
+            continue
         if door_signals(P, state, d, t) if dev_kind[d] == DEV_DOOR else \
                 device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
             seen |= 1 << d
