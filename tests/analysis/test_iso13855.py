@@ -278,6 +278,14 @@ def test_guard_door_check_rows():
     assert any("guard locking holds the door" in ln for ln in good.lines())
 
 
+def test_muting_check():
+    bad = iso.check_cell("muting-long")
+    assert bad.failures() == ["bay-curtain-muting"]
+    assert any("muted 1.50 s after the pallet cleared" in ln for ln in bad.lines())
+    good = iso.check_cell("muting-ok")
+    assert good.ok and len(good.mutings) == 1
+
+
 def test_automatic_restart_check():
     bad = iso.check_cell("restart-auto")
     assert bad.failures() == ["bay-curtain-restart"]

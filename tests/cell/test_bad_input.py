@@ -254,6 +254,13 @@ CASES = [
         ("greater than 0",),
         lambda c: f"devices[{len(c['devices']) - 1}].opening_time",
     ),
+    Case(
+        "muting-ends-before-the-pallet",
+        lambda c: c["devices"][_index(c, "light-curtain")].update(muting={"pallet": [1.0, 2.0], "until": 1.5}),
+        None,
+        ("before the pallet has passed",),
+        lambda c: f"devices[{_index(c, 'light-curtain')}].muting",
+    ),
     Case("start-inside-table", _put_table_on_start, "human.start.xy", ("table",)),
     Case("start-off-floor", _start_off_floor, "human.start.xy", ("not on the floor",)),
     Case(
