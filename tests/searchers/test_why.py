@@ -121,6 +121,17 @@ def test_guard_door_in_words(tmp_path):
     assert check.reproduced, check.problems
 
 
+def test_muting_in_words():
+    """muting-long: nobody saw the worker, the curtain was muted at the contact, and the words say by how much the
+    muting outlasted the pallet."""
+    sim = Simulator("muting-long")
+    res = search(sim, "plan", budget=200, seed=0)
+    why = res.hazard.why
+    assert not why.detected
+    assert "bay-curtain was muted from 0.10 s to" in why.safeguards and "still muted at the contact" in why.safeguards
+    assert "stayed muted 1.50 s after the pallet had cleared the opening" in shortfall(why, check_cell(sim.cell))
+
+
 def test_no_safeguard_words_in_old_results(s1):
     """A cell without the new safeguards writes no ``safeguards`` key: its result files keep their bytes."""
     res = search(s1, "plan", budget=200, seed=0)
