@@ -11,8 +11,8 @@ open; nothing closes it again within an episode.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from cellstress.core.jit import njit
 from cellstress.sim.geometry import point_segment_2d
 from cellstress.sim.layout import C_CYCLE, C_PHASE0, C_STOP_TIME, S_DOOR_OPEN, S_DOOR_REQ, S_TSTOP
 
