@@ -304,7 +304,8 @@ def test_cli_runner_user_error_is_one_line() -> None:
     assert result.stderr.strip() == (
         "error: /no/such/cell.yaml: no such file, and not a built-in cell "
         "(baseline, s1-scanner-width, s2-elbow-intrusion, s3-fence-gap, all-flaws, s2-deceptive, restart-auto, "
-        "restart-manual, warning-field-short, warning-field-ok, mat-short, mat-ok, palletizing, palletizing-fixed)"
+        "restart-manual, warning-field-short, warning-field-ok, mat-short, mat-ok, palletizing, palletizing-fixed, "
+        "door-unlocked, door-locked, muting-long, muting-ok)"
     )
     assert result.stdout == ""
 

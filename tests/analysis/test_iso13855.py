@@ -255,6 +255,8 @@ def test_docs_calibration_example_runs(capsys):
     ("warning-field-ok", "front-scanner", 1.700, 1.789, True),
     ("mat-short", "front-mat", 1.600, 1.189, False),
     ("mat-ok", "front-mat", 1.600, 2.089, True),
+    ("door-unlocked", "bay-door", 1.570, 1.367, False),
+    ("door-locked", "bay-door", 0.0, 1.367, True),
 ])
 def test_safeguard_distances(cell, device, required, actual, ok):
     """Required against actual for the new device kinds (docs/cells.md gives the arithmetic)."""
@@ -262,6 +264,26 @@ def test_safeguard_distances(cell, device, required, actual, ok):
     assert d.required == pytest.approx(required, abs=5e-4)
     assert d.actual == pytest.approx(actual, abs=5e-3)
     assert d.ok is ok
+
+
+def test_guard_door_check_rows():
+    bad = iso.check_cell("door-unlocked")
+    assert bad.failures() == ["bay-door"]
+    lines = bad.lines()
+    assert any("1600*(0.05 + 1 - 0.6 opening) + 850 = 1570 mm" in ln for ln in lines)
+    assert any("access time 0.6 + max(1.367 - 0.850, 0)/1.6 = 0.92 s" in ln and "guard locking required" in ln
+               for ln in lines)
+    good = iso.check_cell("door-locked")
+    assert good.ok
+    assert any("guard locking holds the door" in ln for ln in good.lines())
+
+
+def test_muting_check():
+    bad = iso.check_cell("muting-long")
+    assert bad.failures() == ["bay-curtain-muting"]
+    assert any("muted 1.50 s after the pallet cleared" in ln for ln in bad.lines())
+    good = iso.check_cell("muting-ok")
+    assert good.ok and len(good.mutings) == 1
 
 
 def test_automatic_restart_check():

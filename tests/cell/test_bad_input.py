@@ -85,6 +85,10 @@ def _scanner(cell: dict) -> dict:
     return cell["devices"][_index(cell, "laser-scanner")]
 
 
+def _door(i: int) -> dict:
+    return {"type": "guard-door", "name": f"door-{i}", "start": [-0.6, -2.0 - i], "end": [0.6, -2.0 - i]}
+
+
 @dataclass(frozen=True)
 class Case:
     id: str
@@ -229,6 +233,33 @@ CASES = [
         None,
         ("at least 3 points",),
         lambda c: f"devices[{len(c['devices']) - 1}].polygon",
+    ),
+    Case(
+        "too-many-doors",
+        lambda c: c["devices"].extend(_door(i) for i in range(5)),
+        "devices",
+        ("5 guard doors", "at most 4"),
+    ),
+    Case(
+        "door-automatic-restart",
+        lambda c: c["devices"].append({**_door(0), "restart": {"automatic": 1.0}}),
+        None,
+        ("'manual'",),
+        lambda c: f"devices[{len(c['devices']) - 1}].restart",
+    ),
+    Case(
+        "door-opening-time-zero",
+        lambda c: c["devices"].append({**_door(0), "opening_time": 0}),
+        None,
+        ("greater than 0",),
+        lambda c: f"devices[{len(c['devices']) - 1}].opening_time",
+    ),
+    Case(
+        "muting-ends-before-the-pallet",
+        lambda c: c["devices"][_index(c, "light-curtain")].update(muting={"pallet": [1.0, 2.0], "until": 1.5}),
+        None,
+        ("before the pallet has passed",),
+        lambda c: f"devices[{_index(c, 'light-curtain')}].muting",
     ),
     Case("start-inside-table", _put_table_on_start, "human.start.xy", ("table",)),
     Case("start-off-floor", _start_off_floor, "human.start.xy", ("not on the floor",)),

@@ -13,7 +13,8 @@ from cellstress.report.hazard import FAIL_COLOR, OK_COLOR, StillOptions, _free_s
 from cellstress.sim.build import build_layout
 
 
-@pytest.mark.parametrize("name", ["baseline", "s1-scanner-width", "all-flaws"])
+@pytest.mark.parametrize("name", ["baseline", "s1-scanner-width", "all-flaws", "door-unlocked", "door-locked",
+                                  "muting-long"])
 def test_dimension_lines_carry_the_check_numbers(name) -> None:
     layout = build_layout(load_cell(name))
     static = check_cell(layout.cell, layout)

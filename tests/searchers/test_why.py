@@ -106,6 +106,32 @@ def test_warning_field_in_words():
     assert "requires S = 1.70 m" in words and "short by 0.31 m" in words
 
 
+def test_guard_door_in_words(tmp_path):
+    """door-unlocked: the door let the worker through before the robot was at rest, by how much; the static
+    check's shortfall; the result replays (the door's slots included)."""
+    sim = Simulator("door-unlocked")
+    res = search(sim, "plan", budget=200, seed=0)
+    why = res.hazard.why
+    assert why.detected and why.stopped_by == "bay-door" and why.late_by_s > 0
+    assert ("bay-door opened at 0.70 s without guard locking and let the worker through from 1.30 s, 0.45 s before "
+            "the robot was at rest (1.75 s)") in why.safeguards
+    words = shortfall(why, check_cell(sim.cell))
+    assert "requires S = 1.57 m" in words and "short by 0.20 m" in words
+    check = check_result(SearchResult.load(res.write(tmp_path)), search_again=True)
+    assert check.reproduced, check.problems
+
+
+def test_muting_in_words():
+    """muting-long: nobody saw the worker, the curtain was muted at the contact, and the words say by how much the
+    muting outlasted the pallet."""
+    sim = Simulator("muting-long")
+    res = search(sim, "plan", budget=200, seed=0)
+    why = res.hazard.why
+    assert not why.detected
+    assert "bay-curtain was muted from 0.10 s to" in why.safeguards and "still muted at the contact" in why.safeguards
+    assert "stayed muted 1.50 s after the pallet had cleared the opening" in shortfall(why, check_cell(sim.cell))
+
+
 def test_no_safeguard_words_in_old_results(s1):
     """A cell without the new safeguards writes no ``safeguards`` key: its result files keep their bytes."""
     res = search(s1, "plan", budget=200, seed=0)

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from cellstress.analysis.hazard_zone import Closest, HazardZone, closest_on_zone, hazard_zone, segment_to_zone
+from cellstress.analysis.muting import muting_checks
 from cellstress.analysis.plane import (
     closest_reach,
     detour_nodes,
@@ -43,8 +44,9 @@ from cellstress.analysis.plane import (
     rasterise_zone,
 )
 from cellstress.cell.load import Cell, load_cell
-from cellstress.core.records import ScanPlane, VerticalField
+from cellstress.core.records import DoorLeaf, ScanPlane, VerticalField
 from cellstress.devices.base import DeviceRecord
+from cellstress.devices.guard_door import GuardDoor
 from cellstress.human.body import WALK_BLOCK_HEIGHT
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
@@ -77,6 +79,7 @@ class DeviceCheck:
     # from the cell's phase): what a search can actually meet; for information, ISO uses the whole cycle
     episode_actual: float = math.inf
     field_edges: bool = False  # the entries are the open edges of a scan plane's field (listed one by one)
+    note: str = ""  # a further line of the device kind's own (a guard door: its access time, ISO 14119)
 
 
 @dataclass(frozen=True)
@@ -120,17 +123,19 @@ class StaticCheck:
     episode: float  # s, length of one search episode
     phase_fixed: bool = True  # the worker arrives at the cell's own phase (human.arrival: fixed)
     restarts: tuple = ()  # RestartCheck of every device with an automatic restart
+    mutings: tuple = ()  # analysis.muting.MutingCheck of every muted light curtain
 
     @property
     def ok(self) -> bool:
-        return all(d.ok for d in self.devices) and self.approach.ok and all(r.ok for r in self.restarts)
+        return all(d.ok for d in self.devices) and self.approach.ok and all(r.ok for r in self.restarts + self.mutings)
 
     def failures(self) -> list[str]:
-        """Names of the failed checks: device names, 'undetected-reach' and/or 'DEVICE-restart'."""
+        """Names of the failed checks: device names, 'undetected-reach', 'DEVICE-restart', 'DEVICE-muting'."""
         out = [d.device for d in self.devices if not d.ok]
         if not self.approach.ok:
             out.append("undetected-reach")
         out += [f"{r.device}-restart" for r in self.restarts if not r.ok]
+        out += [f"{m.device}-muting" for m in self.mutings if not m.ok]
         return out
 
     def lines(self) -> list[str]:
@@ -203,9 +208,10 @@ def _device_checks(spec, zone: HazardZone) -> tuple[DeviceCheck, ...]:
         iso = d.required_distance(stop)
         entries, actual, where, ep = _entries_to_zone(d.primitives(), covers, zone, t_ep)
         required = iso.S / 1000.0
+        note = d.access_note(actual, stop) if isinstance(d, GuardDoor) else ""
         out.append(DeviceCheck(d.name, d.type, d.response_time, stop, iso.T, iso.K, iso.C, required,
                                actual, bool(actual >= required - 1e-9), iso.formula, where,
-                               tuple(entries), ep, any(isinstance(p, ScanPlane) for p in d.primitives())))
+                               tuple(entries), ep, any(isinstance(p, ScanPlane) for p in d.primitives()), note))
         warn = d.warning_distance(stop) if isinstance(d, DeviceRecord) else None
         if warn is not None:  # the warning field: measured like a field, against its own distance
             out.append(_warning_check(d, warn, stop, covers, zone, t_ep))
@@ -241,7 +247,7 @@ def _entry_segments(prim, covers) -> list[tuple[tuple[float, float], tuple[float
     if isinstance(prim, ScanPlane):
         poly = prim.polygon
         return [seg for i in range(len(poly)) for seg in open_intervals(poly[i], poly[(i + 1) % len(poly)], covers)]
-    if isinstance(prim, VerticalField):
+    if isinstance(prim, VerticalField | DoorLeaf):  # (a door: its opening)
         return [(tuple(prim.start), tuple(prim.end))]
     raise TypeError(f"unknown detection primitive {type(prim).__name__}")
 
@@ -395,7 +401,7 @@ def check_cell(cell: Cell | str | Path, layout=None) -> StaticCheck:
     approach = _approach_check(spec, layout, zone, panels, lean, ARM_ALLOWANCE)
     return StaticCheck(spec.name, zone, devices, approach, panels, shoulder, float(body[L.B_ARM_LEN]),
                        episode_length(spec), spec.human.arrival == "fixed",
-                       _restart_checks(spec, layout, zone, panels, lean))
+                       _restart_checks(spec, layout, zone, panels, lean), muting_checks(spec))
 
 
 def device_distances(cell: Cell | str | Path, layout=None) -> list[DeviceCheck]:
@@ -441,6 +447,8 @@ def _lines(r: StaticCheck) -> list[str]:
         if r.phase_fixed and math.isfinite(d.episode_actual) and d.episode_actual > d.actual + 5e-4:
             out.append(f"    (during one episode, t = 0..{r.episode:.2f} s from the cell's phase, "
                        f"the robot comes no closer than {d.episode_actual:.3f} m)")
+        if d.note:
+            out.append(f"  {d.note}")
     closed = [p for p in r.fences if p.closed]
     open_ = [p for p in r.fences if not p.closed]
     if closed:
@@ -474,6 +482,7 @@ def _lines(r: StaticCheck) -> list[str]:
             out.append(f"  closest: stand at {_xy(b.stand)}, shoulder at {_xy(b.where.point)}, arm path "
                        f"{b.distance:.3f} m >= {b.arm_allowance:.2f} m? {_verdict(rc.ok)}{_where(b.where, z.cycle)}"
                        + ("" if rc.ok else ": the robot restarts while the worker stands unseen within reach"))
+    out += [m.line() for m in r.mutings]
     fails = r.failures()
     out.append("result: pass" if not fails else f"result: FAIL ({', '.join(fails)})")
     return out

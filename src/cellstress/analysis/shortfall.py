@@ -19,6 +19,10 @@ def distance_words(why: Why, static: StaticCheck) -> str:
                 return (f"ISO 13855 requires S = {d.required:.2f} m; {d.device} stands {d.actual:.2f} m from the "
                         f"hazard zone ({verdict} {gap:.2f} m)")
         return ""
+    muted = [m for m in static.mutings if not m.ok]
+    if muted:
+        return "; ".join(f"{m.device} stayed muted {m.until - m.pallet_out:.2f} s after the pallet had cleared the "
+                         "opening (IEC 62046: the muting ends as it clears)" for m in muted)
     a = static.approach
     if a.distance == float("inf"):
         return "the static check finds no undetected reach to the hazard zone"

@@ -26,7 +26,8 @@ from cellstress.robot.model import load_robot, resolve_urdf, unknown_urdf_messag
 
 BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap", "all-flaws",
                                   "s2-deceptive", "restart-auto", "restart-manual", "warning-field-short",
-                                  "warning-field-ok", "mat-short", "mat-ok", "palletizing", "palletizing-fixed")
+                                  "warning-field-ok", "mat-short", "mat-ok", "palletizing", "palletizing-fixed",
+                                  "door-unlocked", "door-locked", "muting-long", "muting-ok")
 
 
 @dataclass(frozen=True)

@@ -38,6 +38,7 @@ from cellstress.core.fields import (
     PositiveTime,
     Record,
 )
+from cellstress.core.records import MAX_DOORS, DoorLeaf
 
 DEFAULT_CRITERION = "contact-while-moving"
 
@@ -396,6 +397,9 @@ class CellSpec(Record):
                 raise ValueError(f"device names must be unique: devices[{first[d.name]}] and devices[{i}] "
                                  f"are both named {d.name!r}")
             first[d.name] = i
+        doors = [i for i, d in enumerate(v) if any(isinstance(p, DoorLeaf) for p in d.primitives())]
+        if len(doors) > MAX_DOORS:
+            raise ValueError(f"{len(doors)} guard doors (devices{doors}); the simulator takes at most {MAX_DOORS}")
         return v
 
     @field_validator("obstacles")

@@ -28,7 +28,7 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
-from cellstress.core.records import Channel, Contact, IsoDistance, KernelTest, Measures, Primitive
+from cellstress.core.records import Channel, Contact, IsoDistance, KernelTest, Measures, Primitive, TimedPanel
 
 
 # ---- rewards and recorders ----------------------------------------------------------------------------------
@@ -207,6 +207,14 @@ class Channels(Protocol):
     without it gives its ``primitives``, each stopping the robot until a manual reset."""
 
     def channels(self) -> tuple[Channel, ...]: ...
+
+
+@runtime_checkable
+class TimedPanels(Protocol):
+    """A device that brings moving material with it (a muted light curtain's pallet): panels that block like
+    fence panels during windows of the cell's clock (``core.records.TimedPanel``)."""
+
+    def timed_panels(self) -> tuple[TimedPanel, ...]: ...
 
 
 @runtime_checkable

@@ -77,7 +77,39 @@ class VerticalField:
     top: float
 
 
-Primitive = ScanPlane | VerticalField
+MAX_DOORS = 4  # guard doors per cell: the simulator's state has two slots for each (sim.layout.STATE)
+
+
+@dataclass(frozen=True)
+class DoorLeaf:
+    """An interlocked guard door's leaf over the floor segment ``start``-``end`` from ``bottom`` to ``top`` [m]:
+    it blocks walking, the trunk and the arms like a fence panel until it is passable. The worker opens it by
+    walking into it; its interlock signals from that moment. It starts to open then (with ``guard_locking``:
+    once the robot is at rest) and is passable ``opening_time`` [s] later."""
+
+    start: Point2
+    end: Point2
+    bottom: float
+    top: float
+    opening_time: float
+    guard_locking: bool
+
+
+Primitive = ScanPlane | VerticalField | DoorLeaf
+
+
+@dataclass(frozen=True)
+class TimedPanel:
+    """A panel over the floor segment ``start``-``end`` from ``bottom`` to ``top`` [m] that blocks like a fence
+    panel only while the cell's clock, (phase + t) modulo the robot's cycle, lies in [``t_in``, ``t_out``] [s]:
+    a pallet filling a conveyor opening as it passes."""
+
+    start: Point2
+    end: Point2
+    bottom: float
+    top: float
+    t_in: float
+    t_out: float
 
 
 @dataclass(frozen=True)
@@ -92,6 +124,8 @@ class Channel:
     speed: float
     response_time: float
     clear_time: float
+    # muted (sees nothing) while the cell's clock, (phase + t) modulo the robot's cycle, lies in [on, off] [s]
+    muted: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)

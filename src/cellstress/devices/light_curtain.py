@@ -12,10 +12,34 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field, model_validator
 
-from cellstress.core.fields import Elevation, Height, Point2, PositiveTime
+from cellstress.core.fields import Elevation, Height, Point2, PositiveTime, Record
 from cellstress.core.iso13855 import K_HAND, K_WALK, MIN_C_BODY, mm
-from cellstress.core.records import IsoDistance, VerticalField
+from cellstress.core.records import Channel, IsoDistance, TimedPanel, VerticalField
 from cellstress.devices.base import DeviceRecord
+
+ClockTime = Annotated[float, Field(ge=0.0, le=3600.0, allow_inf_nan=False)]
+
+
+class Muting(Record):
+    """Muting at a conveyor opening: a pallet fills the opening while the cell's clock, (phase + t) modulo the
+    robot's cycle, lies in ``pallet``; the curtain is muted from the pallet's arrival until ``until``."""
+
+    pallet: tuple[ClockTime, ClockTime]
+    """When the pallet fills the opening [s of the cell's clock]: it arrives, it has passed."""
+    until: ClockTime
+    """When the muting ends [s of the cell's clock]: at the earliest when the pallet has passed (IEC 62046:
+    muting ends as soon as the material has cleared the opening)."""
+    pallet_height: Height = 1.2
+    """Height of the pallet with its load [m]: it blocks the opening from the floor up to there."""
+
+    @model_validator(mode="after")
+    def _order(self) -> Muting:
+        t_in, t_out = self.pallet
+        if not t_in < t_out:
+            raise ValueError(f"the pallet must arrive before it has passed (pallet: [{t_in}, {t_out}])")
+        if self.until < t_out:
+            raise ValueError(f"until ({self.until}) ends the muting before the pallet has passed ({t_out})")
+        return self
 
 
 def nominal_distance(T: float, resolution_mm: float) -> IsoDistance:
@@ -56,6 +80,8 @@ class LightCurtain(DeviceRecord):
     """Time [s] from detection to the stop signal."""
     resolution_mm: Annotated[float, Field(gt=0.0, le=200.0)] = 30.0
     """Detection capability d [mm] (ISO 13855: the reach-through allowance C grows with it)."""
+    muting: Muting | None = None
+    """Muting for a conveyor opening: the pallet's passage and when the muting ends (absent: never muted)."""
 
     detection_phrase: ClassVar[str] = "breaks the light curtain"
     color: ClassVar[str] = "#7b2cbf"
@@ -70,6 +96,19 @@ class LightCurtain(DeviceRecord):
 
     def primitives(self) -> tuple[VerticalField, ...]:
         return (VerticalField(tuple(self.start), tuple(self.end), self.bottom, self.top),)
+
+    def channels(self) -> tuple[Channel, ...]:
+        muted = None if self.muting is None else (float(self.muting.pallet[0]), float(self.muting.until))
+        return tuple(Channel(p, self.name, 0.0, self.response_time, self.clear_time, muted)
+                     for p in self.primitives())
+
+    def timed_panels(self) -> tuple[TimedPanel, ...]:
+        """The pallet across the opening while it passes (none without muting)."""
+        if self.muting is None:
+            return ()
+        m = self.muting
+        return (TimedPanel(tuple(self.start), tuple(self.end), 0.0, float(m.pallet_height), float(m.pallet[0]),
+                           float(m.pallet[1])),)
 
     def nominal_distance(self, stopping_time: float) -> IsoDistance:
         return nominal_distance(self.response_time + stopping_time, self.resolution_mm)
@@ -86,14 +125,20 @@ class LightCurtain(DeviceRecord):
     def describe(self) -> str:
         (x0, y0), (x1, y1) = self.start, self.end
         restart = "" if self.restart == "manual" else f", automatic restart after {self.clear_time:g} s"
+        muting = "" if self.muting is None else \
+            f", muted {self.muting.pallet[0]:g}..{self.muting.until:g} s (pallet until {self.muting.pallet[1]:g} s)"
         return (f"({x0:g}, {y0:g})-({x1:g}, {y1:g}), {self.bottom:g}..{self.top:g} m, "
-                f"{self.resolution_mm:g} mm{restart}")
+                f"{self.resolution_mm:g} mm{restart}{muting}")
 
     def draw(self, ax):
         from matplotlib.lines import Line2D
 
         (x0, y0), (x1, y1) = self.start, self.end
-        ax.plot([x0, x1], [y0, y1], color=self.color, lw=5, solid_capstyle="butt", zorder=4.5)
+        # a muted curtain dotted (it lets the pallet, and whoever follows it, through)
+        style = "-" if self.muting is None else (0, (1, 1))
+        ax.plot([x0, x1], [y0, y1], color=self.color, lw=5, ls=style, solid_capstyle="butt", zorder=4.5)
         restart = "" if self.restart == "manual" else f", restarts by itself after {self.clear_time:g} s"
-        return Line2D([], [], color=self.color, lw=5, label=f"light curtain '{self.name}' "
+        if self.muting is not None:
+            restart += f", muted {self.muting.pallet[0]:g}-{self.muting.until:g} s of the cycle"
+        return Line2D([], [], color=self.color, lw=5, ls=style, label=f"light curtain '{self.name}' "
                       f"({self.bottom:g}-{self.top:g} m, {self.response_time:g} s{restart})")

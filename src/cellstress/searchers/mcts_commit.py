@@ -6,6 +6,12 @@ committed prefix is cached, not re-simulated). Default ``n`` = budget // horizon
 first decisions), so that the commits use exactly the budget. If the committed path ends (horizon or an
 unsafe state) with budget left (only with an explicit ``n`` or ``until="budget"``), the cycle starts again at
 s0, keeping the tree's statistics.
+
+Measured against the paper's Table III (issue 21, ``benchmarks/mcts_constants.py``, docs/results.md, seeds
+0-39): a fixed n of 10-40 (8 commits take 80-320 iterations; when they end within the budget, a new pass starts
+at s0) made S3's MCTS2 slower (29-37 episodes against 25.8; the paper's 38.0) but S1's no faster (57.7-82.3
+against 59.2; the paper's 49.7). n = 15 put all three MCTS2 rows inside our intervals on seeds 0-39, not on
+40-79 (11 of 18 paper numbers inside there, as with the default), so the default stays.
 """
 
 from __future__ import annotations

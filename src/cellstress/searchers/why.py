@@ -9,6 +9,7 @@ static check.
 from __future__ import annotations
 
 from cellstress.searchers.result import DeviceTiming, Why
+from cellstress.sim import layout as L
 
 
 def _r(t: float) -> float:
@@ -26,11 +27,17 @@ def safeguard_words(layout, records, unsafe_row: int) -> str | None:
     warn = {names[i]: (float(P.dev_speed[i]), float(P.dev_resp[i])) for i in range(len(names))
             if P.dev_speed[i] != 0.0}
     stop_names = {names[i] for i in range(len(names)) if P.dev_speed[i] == 0.0}
+    doors = {names[int(d)]: (float(P.door_open[i]), P.door_lock[i] != 0.0) for i, d in enumerate(P.door_dev)}
     parts, seen_warn = [], set()
     last_stop_seen: tuple[str, float] | None = None
     prev = None
+    first_stop = min((r.t + float(P.dev_resp[names.index(n)]) for r in records[: unsafe_row + 1] for n in r.devices
+                      if n in stop_names), default=None)
+    parts += _muting_words(layout, records[: unsafe_row + 1])
     for r in records[: unsafe_row + 1]:
         for name in r.devices:
+            if name in doors and (prev is None or name not in prev.devices):
+                parts.append(_door_words(name, *doors[name], r.t, first_stop, layout))
             if name in warn and name not in seen_warn:
                 seen_warn.add(name)
                 frac, resp = warn[name]
@@ -48,6 +55,36 @@ def safeguard_words(layout, records, unsafe_row: int) -> str | None:
         return None
     hit = records[unsafe_row]
     return "; ".join(parts) + f"; v_R at the contact {hit.v_R:.2f} m/s ({hit.stop_phase})"
+
+
+def _muting_words(layout, records) -> list[str]:
+    """Each muted channel's muting during the episode up to the contact, from the cell's clock."""
+    P = layout.params
+    phase, cycle = float(P.scal[L.C_PHASE0]), float(P.scal[L.C_CYCLE])
+    out = []
+    for d, name in enumerate(layout.device_names):
+        on, off = float(P.dev_muted[d, 0]), float(P.dev_muted[d, 1])
+        if on == float("inf"):
+            continue
+        times = [r.t for r in records if on <= (phase + r.t) % cycle <= off or on <= (phase + r.t) % cycle + cycle
+                 <= off]
+        if times:
+            still = " (still muted at the contact)" if times[-1] == records[-1].t else ""
+            out.append(f"{name} was muted from {times[0]:.2f} s to {times[-1]:.2f} s ({on:g}..{off:g} s of the "
+                       f"cycle){still}")
+    return out
+
+
+def _door_words(name: str, opening: float, locked: bool, pushed: float, first_stop: float | None, layout) -> str:
+    """A guard door's part of the timeline: when it was pushed, when it let the worker through, and how that
+    compares with the robot's rest (its first stop plus the stopping time)."""
+    rest = None if first_stop is None else _r(first_stop + float(layout.cell.spec.robot.stopping_time))
+    if locked:
+        return f"{name} was pushed at {pushed:.2f} s and stayed locked until the robot was at rest ({rest:.2f} s)"
+    through = _r(pushed + opening)
+    gap = "" if rest is None else (f", {rest - through:.2f} s before the robot was at rest ({rest:.2f} s)"
+                                   if rest > through else f", the robot at rest since {rest:.2f} s")
+    return f"{name} opened at {pushed:.2f} s without guard locking and let the worker through from {through:.2f} s{gap}"
 
 
 def explain(layout, records, unsafe_row: int) -> Why:

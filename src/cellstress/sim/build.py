@@ -10,8 +10,8 @@ import numpy as np
 from cellstress.cell.load import Cell
 from cellstress.cell.program import held_joints, robot_program
 from cellstress.cell.schema import ObstacleSpec
-from cellstress.core.protocols import Channels
-from cellstress.core.records import Channel, ScanPlane, VerticalField
+from cellstress.core.protocols import Channels, TimedPanels
+from cellstress.core.records import MAX_DOORS, Channel, DoorLeaf, ScanPlane, VerticalField
 from cellstress.human.actions import action_table
 from cellstress.human.body import BodyDimensions
 from cellstress.human.reach import ReachField, reach_field
@@ -22,7 +22,7 @@ from cellstress.robot.trajectory import Trajectory
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 
-SCANNER, CURTAIN = L.DEV_SCANNER, L.DEV_CURTAIN  # detection primitive kinds in the kernel
+SCANNER, CURTAIN, DOOR = L.DEV_SCANNER, L.DEV_CURTAIN, L.DEV_DOOR  # detection primitive kinds in the kernel
 
 
 @dataclass(frozen=True)
@@ -38,6 +38,7 @@ class DeviceArrays:
     names: tuple[str, ...]
     speed: np.ndarray  # (nd,) 0: the channel stops the robot; else the reduced speed's fraction
     clear: np.ndarray  # (nd,) s without detection before its stop or reduction is released; inf: manual
+    muted: np.ndarray  # (nd, 2) clock window [on, off] in which the channel sees nothing; (inf, inf): never
 
 
 def pack_polygons(polys) -> tuple[np.ndarray, np.ndarray]:
@@ -51,7 +52,7 @@ def pack_polygons(polys) -> tuple[np.ndarray, np.ndarray]:
 
 def device_arrays(devices) -> DeviceArrays:
     """The kernel's arrays of the cell's devices, from each device's detection primitive."""
-    kinds, resp, rects, polys, names, speed, clear = [], [], [], [], [], [], []
+    kinds, resp, rects, polys, names, speed, clear, muted = [], [], [], [], [], [], [], []
     for d in devices:
         chans = d.channels() if isinstance(d, Channels) else \
             tuple(Channel(p, d.name, 0.0, d.response_time, np.inf) for p in d.primitives())
@@ -63,10 +64,12 @@ def device_arrays(devices) -> DeviceArrays:
             names.append(c.name)
             speed.append(c.speed)
             clear.append(c.clear_time)
+            muted.append((np.inf, np.inf) if c.muted is None else c.muted)
     verts, index = pack_polygons(polys)
     return DeviceArrays(np.asarray(kinds, dtype=np.int64), np.asarray(resp, dtype=float),
                         np.asarray(rects, dtype=float).reshape(-1, 6), index, verts, tuple(names),
-                        np.asarray(speed, dtype=float), np.asarray(clear, dtype=float))
+                        np.asarray(speed, dtype=float), np.asarray(clear, dtype=float),
+                        np.asarray(muted, dtype=float).reshape(-1, 2))
 
 
 def _channel(d, prim, kinds, rects, polys) -> None:
@@ -74,6 +77,10 @@ def _channel(d, prim, kinds, rects, polys) -> None:
         kinds.append(SCANNER)
         rects.append((0.0, 0.0, 0.0, 0.0, prim.height, prim.height))
         polys.append(prim.polygon)
+    elif isinstance(prim, DoorLeaf):
+        kinds.append(DOOR)
+        rects.append((*prim.start, *prim.end, prim.bottom, prim.top))
+        polys.append(())
     elif isinstance(prim, VerticalField):
         kinds.append(CURTAIN)
         rects.append((*prim.start, *prim.end, prim.bottom, prim.top))
@@ -96,6 +103,14 @@ class Layout:
     params: K.SimParams
     joints: JointMap  # the joints the program drives; the others are held or mimic ones
     obstacles: tuple[ObstacleSpec, ...] = ()  # the table's polygons, the cell's obstacles, the robot's pedestal
+
+    @property
+    def static_fences(self) -> bool:
+        """True when the cell has no guard door and no pallet: every fence panel blocks for the whole episode.
+        A door's leaf blocks until it opens (its state slots say when), a pallet while it passes. The verifier's
+        bounds ignore fences altogether (they only shorten the worker's reach and walk), so they hold either
+        way; whatever assumes fixed panels asks this."""
+        return self.params.door_dev.shape[0] == 0 and self.params.panel_fence.shape[0] == 0
 
     @property
     def stops_latch(self) -> bool:
@@ -162,6 +177,17 @@ def build_layout(cell: Cell) -> Layout:
     obs_verts, obs_poly, obs_box = obstacle_arrays(obstacles)
 
     dev = device_arrays(spec.devices)
+    doors = [d for d in range(len(dev.kind)) if dev.kind[d] == DOOR]
+    if len(doors) > MAX_DOORS:  # (the cell schema refuses such a cell first)
+        raise ValueError(f"{len(doors)} guard doors; the simulator takes at most {MAX_DOORS}")
+    door_leaves = [p for d in spec.devices for p in d.primitives() if isinstance(p, DoorLeaf)]
+    # a door's leaf is a fence panel after the fences' own while it is closed (kernels.doors)
+    door_fence = [len(fences) + i for i in range(len(doors))]
+    fences += [tuple(dev.rect[d]) for d in doors]
+    # timed panels (a muted curtain's pallet) after them: they block only within their clock windows
+    timed = [p for d in spec.devices if isinstance(d, TimedPanels) for p in d.timed_panels()]
+    panel_fence = [len(fences) + i for i in range(len(timed))]
+    fences += [(*p.start, *p.end, p.bottom, p.top) for p in timed]
 
     scal = np.zeros(L.N_SCAL)
     scal[L.C_DT] = spec.simulation.dt
@@ -209,6 +235,13 @@ def build_layout(cell: Cell) -> Layout:
         dev_verts=dev.verts,
         dev_speed=dev.speed,
         dev_clear=dev.clear,
+        door_dev=np.asarray(doors, dtype=np.int64),
+        door_fence=np.asarray(door_fence, dtype=np.int64),
+        door_open=np.asarray([p.opening_time for p in door_leaves], dtype=float),
+        door_lock=np.asarray([1.0 if p.guard_locking else 0.0 for p in door_leaves], dtype=float),
+        dev_muted=dev.muted,
+        panel_fence=np.asarray(panel_fence, dtype=np.int64),
+        panel_win=np.asarray([(p.t_in, p.t_out) for p in timed], dtype=float).reshape(-1, 2),
         pre_ra=np.zeros((0, len(caps), 3)),
         pre_rb=np.zeros((0, len(caps), 3)),
         pre_v=np.zeros(0),

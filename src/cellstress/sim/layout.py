@@ -10,6 +10,7 @@ kernels, so where a slot lives is decided in this file alone.
 
 from __future__ import annotations
 
+from cellstress.core.records import MAX_DOORS
 from cellstress.core.vector_spec import VectorSpec
 from cellstress.human.body import (  # noqa: F401  (re-exported: the kernels and their callers read them here)
     B_ARM_LEN,
@@ -30,6 +31,8 @@ from cellstress.human.body import (  # noqa: F401  (re-exported: the kernels and
     N_BODY_PARAMS,
     N_CAPSULES,
 )
+
+_DOOR_SLOTS = tuple(f"DOOR{i}_{what}" for what in ("REQ", "OPEN") for i in range(MAX_DOORS))
 
 STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
     ("K", "time step k (a float): the state's time is k * dt"),
@@ -58,11 +61,21 @@ STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
     ("SLOW_SEEN", "last time a warning field saw the worker [s]; -1: never"),
     ("SLOW_CLEAR", "the same for the latched speed reduction"),
     ("RESTARTS", "stops released so far"),
+    # interlocked guard doors (issue 18): two slots per door, MAX_DOORS doors, in the order of SimParams.door_dev
+    *((f"DOOR{i}_REQ", f"guard door {i}: time the worker first pushed it [s] (its interlock's stop request); "
+                       "inf: not yet") for i in range(MAX_DOORS)),
+    *((f"DOOR{i}_OPEN", f"guard door {i}: time it started to open [s] (with guard locking: once the robot was "
+                        "at rest); passable from this time plus its opening time; inf: closed")
+      for i in range(MAX_DOORS)),
 ))
 (S_K, S_X, S_Y, S_HEADING, S_FWD, S_LAT, S_TSTOP, S_TRIG_DEV, S_TRIG_T, S_UNSAFE, S_ACTIONS, S_LIVE, S_A_T, S_A_TAU,
- S_A_SIG, S_A_TGT, S_TSLOW, S_SLOW, S_STOP_SEEN, S_STOP_CLEAR, S_SLOW_SEEN, S_SLOW_CLEAR, S_RESTARTS) = STATE.indices(
+ S_A_SIG, S_A_TGT, S_TSLOW, S_SLOW, S_STOP_SEEN, S_STOP_CLEAR, S_SLOW_SEEN, S_SLOW_CLEAR, S_RESTARTS,
+ S_DOOR0_REQ, S_DOOR1_REQ, S_DOOR2_REQ, S_DOOR3_REQ, S_DOOR0_OPEN, S_DOOR1_OPEN, S_DOOR2_OPEN,
+ S_DOOR3_OPEN) = STATE.indices(
     "K", "X", "Y", "HEADING", "FWD", "LAT", "TSTOP", "TRIG_DEV", "TRIG_T", "UNSAFE", "ACTIONS", "LIVE", "A_T", "A_TAU",
-    "A_SIG", "A_TGT", "TSLOW", "SLOW", "STOP_SEEN", "STOP_CLEAR", "SLOW_SEEN", "SLOW_CLEAR", "RESTARTS")
+    "A_SIG", "A_TGT", "TSLOW", "SLOW", "STOP_SEEN", "STOP_CLEAR", "SLOW_SEEN", "SLOW_CLEAR", "RESTARTS",
+    *_DOOR_SLOTS)
+S_DOOR_REQ, S_DOOR_OPEN = S_DOOR0_REQ, S_DOOR0_OPEN  # door i's slots: these + i (the kernels index by door)
 NS = STATE.size
 
 ROW = VectorSpec("metric row (one per time step; row 0 of an episode is its start)", (
@@ -123,8 +136,10 @@ N_SCAL = SCALARS.size
 DEVICE_KINDS = VectorSpec("detection primitive kinds (SimParams.dev_kind)", (
     ("SCANNER", "horizontal scan plane over a polygon (dev_poly, dev_verts; its height in dev_rect[4])"),
     ("CURTAIN", "vertical rectangle (dev_rect: x0 y0 x1 y1 bottom top)"),
+    ("DOOR", "an interlocked guard door's switch (dev_rect: the leaf's x0 y0 x1 y1 bottom top): it signals from "
+             "the time the worker pushes the door (its DOORi_REQ slot, i = the door's index in SimParams.door_dev)"),
 ))
-DEV_SCANNER, DEV_CURTAIN = DEVICE_KINDS.indices("SCANNER", "CURTAIN")
+DEV_SCANNER, DEV_CURTAIN, DEV_DOOR = DEVICE_KINDS.indices("SCANNER", "CURTAIN", "DOOR")
 
 JOINT_KINDS = VectorSpec("robot joint kinds (SimParams.jtype)", (
     ("REVOLUTE", "turns by q [rad] about its axis"),

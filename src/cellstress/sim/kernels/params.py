@@ -43,6 +43,13 @@ class SimParams(NamedTuple):
     dev_verts: np.ndarray  # (V, 2)
     dev_speed: np.ndarray  # (nd,) 0: detection latches a stop; else a warning field's reduced speed fraction
     dev_clear: np.ndarray  # (nd,) automatic restart's clear time [s]; inf: manual (latched for the episode)
+    door_dev: np.ndarray  # (n_doors,) int64: door i's channel (a DEV_DOOR row of dev_*); its state slots: layout
+    door_fence: np.ndarray  # (n_doors,) int64: door i's leaf, a row of fences (blocks only while not passable)
+    door_open: np.ndarray  # (n_doors,) opening time [s]: passable this long after it starts to open
+    door_lock: np.ndarray  # (n_doors,) 1: guard locking (starts to open only once the robot is at rest)
+    dev_muted: np.ndarray  # (nd, 2) cell-clock window [on, off] in which channel d sees nothing; (inf, inf): never
+    panel_fence: np.ndarray  # (n_panels,) int64: timed panels (a pallet), rows of fences blocking only in a window
+    panel_win: np.ndarray  # (n_panels, 2) cell-clock window [in, out] in which timed panel i blocks
     pre_ra: np.ndarray  # (n_pre, nc, 3) robot capsules at step k before any stop (a cache: see robot_at)
     pre_rb: np.ndarray
     pre_v: np.ndarray  # (n_pre,) v_R
@@ -66,6 +73,7 @@ class Work(NamedTuple):
     lbs: np.ndarray
     ts: np.ndarray
     stopped: np.ndarray  # (2,) t_stop, v_R of the standstill pose held in ra/rb, or NaN (see robot_at)
+    fences: np.ndarray  # P.fences with every passable door's leaf moved out of the way (kernels.doors)
 
 
 @njit(cache=True, error_model="numpy")
@@ -78,5 +86,5 @@ def make_work(P):
         np.zeros((N_BODY_CAPSULES, 3)), np.zeros((N_BODY_CAPSULES, 3)), np.zeros(N_BODY_CAPSULES),
         np.zeros((2, 3)), np.zeros((3, 3)), np.zeros(P.fences.shape[0] + 1, dtype=np.int64),
         np.zeros(3),
-        np.zeros(2 * nc), np.zeros(2 * nc), np.full(2, np.nan),
+        np.zeros(2 * nc), np.zeros(2 * nc), np.full(2, np.nan), P.fences.copy(),
     )

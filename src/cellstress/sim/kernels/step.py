@@ -13,6 +13,7 @@ import numpy as np
 from cellstress.core.jit import njit
 from cellstress.sim.geometry import NO_REFCOUNT, segment_segment_xyz
 from cellstress.sim.kernels.body import pose_body
+from cellstress.sim.kernels.doors import door_signals, muted, note_push, place_doors, push_doors, unlock_doors
 from cellstress.sim.kernels.fences import collect_near_fences
 from cellstress.sim.kernels.reach import reach_value_at
 from cellstress.sim.kernels.robot import live_path_time, robot_at
@@ -28,6 +29,7 @@ from cellstress.sim.layout import (
     C_REACH_H,
     C_REACH_ORIGIN,
     C_VTOL,
+    DEV_DOOR,
     M_ACTION,
     M_FWD,
     M_HEADING,
@@ -41,6 +43,7 @@ from cellstress.sim.layout import (
     M_V,
     M_X,
     M_Y,
+    MAX_DOORS,
     N_BODY_CAPSULES,
     NS,
     S_A_SIG,
@@ -48,6 +51,8 @@ from cellstress.sim.layout import (
     S_A_TAU,
     S_A_TGT,
     S_ACTIONS,
+    S_DOOR_OPEN,
+    S_DOOR_REQ,
     S_FWD,
     S_HEADING,
     S_K,
@@ -79,20 +84,25 @@ def sense_and_measure(P, state, W, row, action):
     t = k * dt
     ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
     pose_body(P.body, state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT], ha, hb, hr, sh, tr)
-    n_near = collect_near_fences(P.fences, sh, W.near, P.body[B_ARM_LEN] + 0.05)
     seen = 0
     dev_kind, dev_rect, dev_poly, dev_verts, body = P.dev_kind, P.dev_rect, P.dev_poly, P.dev_verts, P.body
     for d in range(dev_kind.shape[0]):
-        if device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
+        if muted(P, d, t):
+            continue
+        if door_signals(P, state, d, t) if dev_kind[d] == DEV_DOOR else \
+                device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
             seen |= 1 << d
             if P.dev_speed[d] != 0.0:  # a warning field: a speed reduction, latched like a stop
                 sense_warning(P, state, d, t)
             else:
                 sense_stop(P, state, d, t)
     release(P, state, t)
+    unlock_doors(P, state, t)
+    place_doors(P, state, W.fences, t)
+    n_near = collect_near_fences(W.fences, sh, W.near, P.body[B_ARM_LEN] + 0.05)
     v, phase, tau = robot_at(P, int(k), state, W)
     cap_r, reach, origin, grid_h, arm_len, fences = P.cap_r, P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], \
-        P.body[B_ARM_LEN], P.fences
+        P.body[B_ARM_LEN], W.fences
     ra, rb, near, lbs, ts, q = W.ra, W.rb, W.near, W.lbs, W.ts, W.best_r
     # One inlined copy of separation: a second, fence-free copy (n_near the constant 0) cost ~8 s of a cold
     # compile for no measurable speed (the fence code is skipped by a branch on n_near either way).
@@ -136,11 +146,14 @@ def latch_seen(P, state, seen, t):
     rows with it)."""
     for d in range(P.dev_kind.shape[0]):
         if seen >> d & 1:
+            if P.dev_kind[d] == DEV_DOOR:
+                note_push(P, state, d, t)
             if P.dev_speed[d] != 0.0:
                 sense_warning(P, state, d, t)
             else:
                 sense_stop(P, state, d, t)
     release(P, state, t)
+    unlock_doors(P, state, t)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -196,6 +209,8 @@ def reset_state(P, x, y, heading, state, W, row):
     state[S_SLOW] = 1.0
     state[S_STOP_SEEN] = state[S_SLOW_SEEN] = -1.0
     state[S_STOP_CLEAR] = state[S_SLOW_CLEAR] = np.inf  # nothing to release (a stop set by hand holds, as before)
+    for i in range(MAX_DOORS):  # every door closed, none pushed
+        state[S_DOOR_REQ + i] = state[S_DOOR_OPEN + i] = np.inf
     sense_and_measure(P, state, W, row, np.int64(-1))  # not a literal: see batch.py
 
 
@@ -224,11 +239,14 @@ def step_action(P, state, action, W, out, row0):
 @njit(cache=True, error_model="numpy", inline="always")
 def move_worker(P, state, action, h0, f0, l0, frac, W):
     """The worker's own motion over one time step of ``action`` (begun at heading h0 and posture f0, l0):
-    ``frac`` of the action done. It depends on the actions and the fixed layout only, never on the robot."""
+    ``frac`` of the action done. It depends on the actions and the fixed layout only, never on the robot, except
+    through a door with guard locking (it opens once the robot is at rest: ``doors.unlock_doors``)."""
     walks = P.act[action, 0]
-    body, fences, floor, obs_verts, obs_poly, obs_box = P.body, P.fences, P.floor, P.obs_verts, P.obs_poly, P.obs_box
+    body, fences, floor, obs_verts, obs_poly, obs_box = P.body, W.fences, P.floor, P.obs_verts, P.obs_poly, P.obs_box
     ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
     x, y = state[S_X], state[S_Y]
+    t = state[S_K] * P.scal[C_DT]
+    place_doors(P, state, fences, t)
     h = h0 + P.act[action, 1] * frac
     f = f0 + (P.act[action, 2] - f0) * frac
     lt = l0 + (P.act[action, 3] - l0) * frac
@@ -237,6 +255,8 @@ def move_worker(P, state, action, h0, f0, l0, frac, W):
         stride = body[B_WALK_SPEED] * P.scal[C_DT]
         nx, ny = x + stride * np.cos(h), y + stride * np.sin(h)
         if not feet_ok(body[B_BODY_RADIUS], floor, obs_verts, obs_poly, fences, nx, ny):
+            # walking into a closed door pushes it (at the time of the step being taken)
+            push_doors(P, state, body[B_BODY_RADIUS], nx, ny, t + P.scal[C_DT])
             nx, ny = x, y
     # If the new posture would put the trunk through a fence, keep the old posture where it stands; if that
     # fails too, stay put. (A loop, so that pose_body and trunk_clear are inlined once, not twice: each
@@ -255,7 +275,8 @@ def move_worker(P, state, action, h0, f0, l0, frac, W):
 def worker_paths(P, s0, actions, W, out):
     """The worker's poses (x, y, heading, forward, lateral flexion) at every time step of each episode of
     ``actions`` (n, n_actions) played from s0, as if no contact ended it: the open-loop part of the simulation
-    (``move_worker``), without robot, devices or measuring. out: (n, n_actions * spa, 5)."""
+    (``move_worker``), without robot, devices or measuring. out: (n, n_actions * spa, 5). A door without guard
+    locking opens here as played; one with guard locking stays locked (the robot's rest is not simulated)."""
     state = np.empty(NS)
     spa = P.spa
     for e in range(actions.shape[0]):
@@ -265,6 +286,7 @@ def worker_paths(P, s0, actions, W, out):
             h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
             for j in range(1, spa + 1):
                 move_worker(P, state, actions[e, a], h0, f0, l0, j / spa, W)
+                state[S_K] += 1.0  # (a door pushed opens on the clock)
                 out[e, k, 0], out[e, k, 1], out[e, k, 2] = state[S_X], state[S_Y], state[S_HEADING]
                 out[e, k, 3], out[e, k, 4] = state[S_FWD], state[S_LAT]
                 k += 1
