@@ -51,6 +51,8 @@ COMMANDS = [
     ["search", "restart-auto", "--searcher", "plan", "--budget", "20", "--seed", "0", "--out", "{out}/ra"],
     ["search", "warning-field-short", "--searcher", "plan", "--budget", "20", "--seed", "0", "--out", "{out}/w"],
     ["search", "mat-short", "--searcher", "random", "--budget", "20", "--seed", "0", "--out", "{out}/mat"],
+    ["search", "door-unlocked", "--searcher", "plan", "--budget", "20", "--seed", "0", "--out", "{out}/door"],
+    ["search", "muting-long", "--searcher", "random", "--budget", "20", "--seed", "0", "--out", "{out}/mute"],
     ["simulate", "s3-fence-gap", "--actions", "walk+upright,walk+upright"],
     ["check", "s3-fence-gap"],
     ["show", "s3-fence-gap", "--out", "{out}/show.png"],
