@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import Discriminator, Tag
+from pydantic import Discriminator, Field, Tag
 
 from cellstress.core.fields import Name, PositiveTime, Record
 from cellstress.core.records import Channel, IsoDistance
@@ -39,6 +39,10 @@ class DeviceRecord(Record):
     """How its stop is released: ``manual`` (a reset outside the cell: the robot stays stopped for the rest of
     the episode) or ``{automatic: CLEAR_TIME}`` (the robot restarts once this device has not seen the worker for
     CLEAR_TIME seconds and no other device holds a stop)."""
+
+    stops: tuple[Annotated[str, Field(min_length=1, max_length=32)], ...] | None = Field(None, min_length=1,
+                                                                                       max_length=4)
+    """The robots its detection stops, by name (``robots[].name``); absent: every robot of the cell."""
 
     @property
     def clear_time(self) -> float:

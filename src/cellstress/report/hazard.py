@@ -163,7 +163,7 @@ def topview_figure(view: EpisodeView, size: D.FigureSize = StillOptions().topvie
     zone = zone if zone is not None else D.swept_footprint(view.layout)
     pose = view.pose(key)
     reach = [view.reach(key, side, REACH_STRIDE_STILL, pose) for side in (0, 1)]
-    handles = D.draw_plan(ax, view.layout, robot_tau=float(view.taus[key]), zone=zone,
+    handles = D.draw_plan(ax, view.layout, robot_tau=view.taus[key], zone=zone,
                           robot_when="at contact" if view.unsafe else "at the closest call")
     _draw_episode(ax, view, pose, reach, handles, mark_size=0.16)
     spec = view.layout.cell.spec
@@ -172,7 +172,7 @@ def topview_figure(view: EpisodeView, size: D.FigureSize = StillOptions().topvie
     _legend(fig, ax, handles)
     # the enlarged view: the path, the touching reach volume and the contact, with a margin
     inset = fig.add_axes(INSET_AXES)
-    D.draw_plan(inset, view.layout, D.PlanStyle(start_size=0.12), robot_tau=float(view.taus[key]), zone=zone)
+    D.draw_plan(inset, view.layout, D.PlanStyle(start_size=0.12), robot_tau=view.taus[key], zone=zone)
     _draw_episode(inset, view, pose, reach, None, mark_size=0.08)
     recs = view.records
     hit = recs[key]

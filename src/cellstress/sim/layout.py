@@ -58,12 +58,17 @@ STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
     ("SLOW_SEEN", "last time a warning field saw the worker [s]; -1: never"),
     ("SLOW_CLEAR", "the same for the latched speed reduction"),
     ("RESTARTS", "stops released so far"),
+    # several robots: robot 0's stop is TSTOP above; robots 1..3 latch their own (appended: nothing above moves)
+    ("XTSTOP1", "time robot 1's latched stop takes effect [s]; inf: none latched (or no such robot)"),
+    ("XTSTOP2", "the same for robot 2"),
+    ("XTSTOP3", "the same for robot 3"),
 ))
 (S_K, S_X, S_Y, S_HEADING, S_FWD, S_LAT, S_TSTOP, S_TRIG_DEV, S_TRIG_T, S_UNSAFE, S_ACTIONS, S_LIVE, S_A_T, S_A_TAU,
- S_A_SIG, S_A_TGT, S_TSLOW, S_SLOW, S_STOP_SEEN, S_STOP_CLEAR, S_SLOW_SEEN, S_SLOW_CLEAR, S_RESTARTS) = STATE.indices(
+ S_A_SIG, S_A_TGT, S_TSLOW, S_SLOW, S_STOP_SEEN, S_STOP_CLEAR, S_SLOW_SEEN, S_SLOW_CLEAR, S_RESTARTS, S_XTSTOP, _, _) = STATE.indices(
     "K", "X", "Y", "HEADING", "FWD", "LAT", "TSTOP", "TRIG_DEV", "TRIG_T", "UNSAFE", "ACTIONS", "LIVE", "A_T", "A_TAU",
-    "A_SIG", "A_TGT", "TSLOW", "SLOW", "STOP_SEEN", "STOP_CLEAR", "SLOW_SEEN", "SLOW_CLEAR", "RESTARTS")
+    "A_SIG", "A_TGT", "TSLOW", "SLOW", "STOP_SEEN", "STOP_CLEAR", "SLOW_SEEN", "SLOW_CLEAR", "RESTARTS", "XTSTOP1", "XTSTOP2", "XTSTOP3")
 NS = STATE.size
+MAX_ROBOTS = 4  # robot r >= 1 keeps its stop in S_XTSTOP + r - 1 and its path in the row's XTAU and XPHASE slots
 
 ROW = VectorSpec("metric row (one per time step; row 0 of an episode is its start)", (
     ("T", "time [s]"),
@@ -88,11 +93,19 @@ ROW = VectorSpec("metric row (one per time step; row 0 of an episode is its star
     ("TAU", "robot's path time [s]"),
     ("ACTION", "action played; -1 in an episode's first row"),
     ("STEP", "time step k"),
+    # several robots (appended): V above is the speed of the robot that owns LINK; TAU and PHASE are robot 0's
+    ("ROBOT", "robot owning the capsule LINK (0 in a one-robot cell); -1: none"),
+    ("XTAU1", "robot 1's path time [s]; NaN: no such robot"),
+    ("XTAU2", "robot 2's path time [s]"),
+    ("XTAU3", "robot 3's path time [s]"),
+    ("XPHASE1", "robot 1's stop phase (PHASE); NaN: no such robot"),
+    ("XPHASE2", "robot 2's stop phase"),
+    ("XPHASE3", "robot 3's stop phase"),
 ))
 (M_T, M_X, M_Y, M_HEADING, M_FWD, M_LAT, M_D, M_V, M_SEEN, M_PHASE, M_LINK, M_PART, M_RX, M_RY, M_RZ, M_HX, M_HY, M_HZ,
- M_UNSAFE, M_TAU, M_ACTION, M_STEP) = ROW.indices(
+ M_UNSAFE, M_TAU, M_ACTION, M_STEP, M_ROBOT, M_XTAU, _, _, M_XPHASE, _, _) = ROW.indices(
     "T", "X", "Y", "HEADING", "FWD", "LAT", "D", "V", "SEEN", "PHASE", "LINK", "PART", "RX", "RY", "RZ", "HX", "HY",
-    "HZ", "UNSAFE", "TAU", "ACTION", "STEP")
+    "HZ", "UNSAFE", "TAU", "ACTION", "STEP", "ROBOT", "XTAU1", "XTAU2", "XTAU3", "XPHASE1", "XPHASE2", "XPHASE3")
 NM = ROW.size
 
 PHASE = VectorSpec("robot stop phase (values of the row's PHASE; records.STOP_PHASES names them in files)", (
