@@ -18,11 +18,11 @@ from pydantic import BaseModel, ValidationError
 from cellstress.cell.program import robot_program
 from cellstress.cell.schema import CRITERIA, DEVICE_KINDS, CellSpec
 from cellstress.core import registry
-from cellstress.core.protocols import Channels
-from cellstress.core.records import Channel
 from cellstress.core.errors import CellError, CellstressError
 from cellstress.core.io import MAX_INPUT_BYTES, InputFileError, read_input_bytes
 from cellstress.core.plane import point_segment_distance, polygon_distance
+from cellstress.core.protocols import Channels
+from cellstress.core.records import Channel
 from cellstress.human.body import BODY_RADIUS, WALK_BLOCK_HEIGHT
 from cellstress.robot.model import load_robot, resolve_urdf, unknown_urdf_message
 
@@ -343,7 +343,7 @@ def check_geometry(cell: Cell) -> None:
     """Checks that need more than one field: the URDF, the robot's program against its joints and their
     position and velocity limits, the robot's cycle time, the robots' names and the devices' ``stops``, the start
     pose and every named start point."""
-    spec, src = cell.spec, cell.source
+    spec = cell.spec
     several = "robots" in spec.model_fields_set  # a robots list, even of one: its errors name robots[i]
     for i, rs in enumerate(spec.robots):
         _check_robot(cell, rs, f"robots[{i}]" if several else "robot")

@@ -241,13 +241,13 @@ def draw_obstacles(ax, layout: Layout) -> list:
     for o in layout.obstacles:
         face, edge = obstacle_colors(o)
         ax.add_patch(Polygon(o.footprint(), closed=True, facecolor=face, edgecolor=edge, lw=1.0, zorder=1))
-        if not _is_table(o) and o.name != PEDESTAL:  # (the robot base marker shows the pedestal)
+        if not _is_table(o) and not _is_pedestal(layout, o):  # (the robot base marker shows the pedestal)
             cx, cy = np.mean(np.asarray(o.footprint(), float), axis=0)
             ax.annotate(f"{o.name}\n{o.height:g} m", (cx, cy), ha="center", va="center", fontsize=6,
                         color=edge, zorder=1.5, annotation_clip=True)
     if tables:
         handles.append(Patch(facecolor=TABLE, edgecolor=TABLE_EDGE, label=f"table ({tables[0].height:g} m)"))
-    if any(not _is_table(o) and o.name != PEDESTAL for o in layout.obstacles):
+    if any(not _is_table(o) and not _is_pedestal(layout, o) for o in layout.obstacles):
         handles.append(Patch(facecolor=OBSTACLE, edgecolor=OBSTACLE_EDGE, label="obstacle (name, height)"))
     return handles
 
@@ -263,3 +263,8 @@ def draw_pose_arrow(ax, x: float, y: float, heading: float, color: str, size: fl
                     alpha=alpha)
     ax.add_patch(patch)
     return patch
+
+
+def _is_pedestal(layout: Layout, o) -> bool:
+    """A robot's own pedestal (``sim.build.pedestal``: after the cell's obstacles, one per robot)."""
+    return o.name == PEDESTAL or o in layout.obstacles[len(layout.cell.spec.solid_obstacles()):]

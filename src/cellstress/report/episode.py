@@ -116,7 +116,8 @@ def replay(sim: Simulator, actions, *, episode: int | None = None, kind: str = "
     # the actions actually played: an unsafe step ends the episode and drops the actions after it
     n_played = -(-(len(records) - 1) // sim.steps_per_action)
     acts = tuple(ACTION_NAMES[action_index(a)] for a in list(actions)[:n_played])
-    return EpisodeView(sim.layout, sim.start, acts, tuple(records), scene.path_times(trace.rows, len(sim.layout.robots)), episode, kind,
+    taus = scene.path_times(trace.rows, len(sim.layout.robots))
+    return EpisodeView(sim.layout, sim.start, acts, tuple(records), taus, episode, kind,
                        matches)
 
 

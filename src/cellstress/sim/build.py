@@ -122,7 +122,8 @@ def pedestal(rs: RobotSpec, robot: RobotModel, several: bool = False) -> Obstacl
     height = float(m[2, 3]) + top
     if height <= 0.0:
         return None
-    return ObstacleSpec.model_construct(name=f"{rs.name}-pedestal" if several else PEDESTAL, polygon=tuple(map(tuple, world.tolist())), box=None,
+    name = f"{rs.name}-pedestal" if several else PEDESTAL
+    return ObstacleSpec.model_construct(name=name, polygon=tuple(map(tuple, world.tolist())), box=None,
                                         height=height)
 
 

@@ -64,9 +64,11 @@ STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
     ("XTSTOP3", "the same for robot 3"),
 ))
 (S_K, S_X, S_Y, S_HEADING, S_FWD, S_LAT, S_TSTOP, S_TRIG_DEV, S_TRIG_T, S_UNSAFE, S_ACTIONS, S_LIVE, S_A_T, S_A_TAU,
- S_A_SIG, S_A_TGT, S_TSLOW, S_SLOW, S_STOP_SEEN, S_STOP_CLEAR, S_SLOW_SEEN, S_SLOW_CLEAR, S_RESTARTS, S_XTSTOP, _, _) = STATE.indices(
+ S_A_SIG, S_A_TGT, S_TSLOW, S_SLOW, S_STOP_SEEN, S_STOP_CLEAR, S_SLOW_SEEN, S_SLOW_CLEAR, S_RESTARTS, S_XTSTOP, _,
+ _) = STATE.indices(
     "K", "X", "Y", "HEADING", "FWD", "LAT", "TSTOP", "TRIG_DEV", "TRIG_T", "UNSAFE", "ACTIONS", "LIVE", "A_T", "A_TAU",
-    "A_SIG", "A_TGT", "TSLOW", "SLOW", "STOP_SEEN", "STOP_CLEAR", "SLOW_SEEN", "SLOW_CLEAR", "RESTARTS", "XTSTOP1", "XTSTOP2", "XTSTOP3")
+    "A_SIG", "A_TGT", "TSLOW", "SLOW", "STOP_SEEN", "STOP_CLEAR", "SLOW_SEEN", "SLOW_CLEAR", "RESTARTS", "XTSTOP1",
+    "XTSTOP2", "XTSTOP3")
 NS = STATE.size
 MAX_ROBOTS = 4  # robot r >= 1 keeps its stop in S_XTSTOP + r - 1 and its path in the row's XTAU and XPHASE slots
 

@@ -26,6 +26,7 @@ from cellstress.sim.layout import (
     C_PHASE0,
     C_STOP_TIME,
     JOINT_PRISMATIC,
+    NS,
     PHASE_BRAKING,
     PHASE_PENDING,
     PHASE_REDUCED,
@@ -40,7 +41,6 @@ from cellstress.sim.layout import (
     S_TSLOW,
     S_TSTOP,
     S_XTSTOP,
-    NS,
 )
 
 
