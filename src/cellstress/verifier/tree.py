@@ -10,7 +10,8 @@ that falls on a merged state is the one whose prefix is the smallest.
 **Merging.** Two states merge when their future is the same: the same time step and actions played (true of a
 whole layer), positions equal to within ``QUANT_XY`` (1 um), heading (modulo a full turn), forward and lateral
 flexion equal to within ``QUANT_ANGLE`` (1e-9 rad), the latched stop time ``TSTOP`` bit for bit and the same
-triggering device. The rest of the state does not reach the future: the first detection time ``TRIG_T`` is
+triggering device, and in a cell of several robots each other robot's latched stop ``XTSTOP`` bit for bit. The
+rest of the state does not reach the future: the first detection time ``TRIG_T`` is
 written by ``sense_and_measure`` and read by nothing; ``TRIG_DEV`` is only compared with -1 to decide whether
 to write ``TRIG_T``; neither enters the worker's motion, the robot (``robot_at`` reads the step and ``TSTOP``)
 or the unsafe test. ``TRIG_DEV`` is kept in the key all the same, because it names the device of a hazard's
@@ -81,13 +82,15 @@ class TreeOutcome:
 
 def merge_keys(states: np.ndarray) -> np.ndarray:
     """One fixed-size byte key per state (rows of ``states``): equal keys, equal futures (see the module)."""
-    key = np.empty((len(states), 6), dtype=np.int64)
+    key = np.empty((len(states), 6 + L.MAX_ROBOTS - 1), dtype=np.int64)
     key[:, 0] = np.rint(states[:, L.S_X] / QUANT_XY)
     key[:, 1] = np.rint(states[:, L.S_Y] / QUANT_XY)
     key[:, 2] = np.rint(np.mod(states[:, L.S_HEADING], TWO_PI) / QUANT_ANGLE)
     key[:, 3] = np.rint(states[:, L.S_FWD] / QUANT_ANGLE)
     key[:, 4] = np.rint(states[:, L.S_LAT] / QUANT_ANGLE)
     key[:, 5] = states[:, L.S_TSTOP].view(np.int64) * 8 + (states[:, L.S_TRIG_DEV].astype(np.int64) + 1)
+    # robots 1..3's latched stops (inf in every state of a one-robot cell: the same partition and order as without)
+    key[:, 6:] = np.ascontiguousarray(states[:, L.S_XTSTOP:L.S_XTSTOP + L.MAX_ROBOTS - 1]).view(np.int64)
     return np.ascontiguousarray(key).view(np.dtype((np.void, key.dtype.itemsize * key.shape[1]))).ravel()
 
 
