@@ -116,8 +116,8 @@ def sense_and_measure(P, state, W, row, action):
     unsafe = d_hr <= P.scal[C_DTOL] and v > P.scal[C_VTOL]
     row[M_ROBOT] = owner
     for r in range(MAX_ROBOTS - 1):
-        row[M_XTAU + r] = W.xtau[r] if r < nx else np.nan
-        row[M_XPHASE + r] = W.xphase[r] if r < nx else np.nan
+        row[M_XTAU + r] = W.xtau[r] if r < nx else -1.0  # (not NaN: rows are compared with array_equal)
+        row[M_XPHASE + r] = W.xphase[r] if r < nx else -1.0
     row[M_T] = t
     row[M_X], row[M_Y], row[M_HEADING] = state[S_X], state[S_Y], state[S_HEADING]
     row[M_FWD], row[M_LAT] = state[S_FWD], state[S_LAT]
