@@ -10,7 +10,8 @@ import pytest
 import yaml
 
 from cellstress.analysis.replay import check_result
-from cellstress.cell.load import builtin_text, parse_cell
+from cellstress.cell.load import builtin_text, load_cell, parse_cell, with_criterion
+from cellstress.core.errors import CellstressError
 from cellstress.robot.model import base_matrix, resolve_urdf
 from cellstress.searchers import search
 from cellstress.sim import kernels as K
@@ -113,3 +114,8 @@ def test_two_robot_hazard_replays_bit_exactly(flawed):
     assert hz.robot_link.startswith("b:")  # the hazard names the robot it touched, and the link
     check = check_result(res, search_again=False)
     assert check.reproduced, check
+
+
+def test_contact_judging_criterion_is_refused_with_two_robots():
+    with pytest.raises(CellstressError, match="several robots"):
+        Simulator(with_criterion(load_cell("two-robots"), "iso15066"))
