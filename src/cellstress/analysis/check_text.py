@@ -26,8 +26,11 @@ def check_lines(r) -> list[str]:
     """The lines of a ``StaticCheck``."""
     z = r.zone
     x0, x1, y0, y1 = z.extent()
-    out = [f"hazard zone: robot capsules over one {z.cycle:.2f} s cycle every {z.sample_dt * 1000:.0f} ms, "
+    each = f" ({', '.join(f'{n} {c:.2f} s' for n, c in r.robot_cycles)}: each robot over its own)" \
+        if r.robot_cycles else ""
+    out = [f"hazard zone: robot capsules over one {z.cycle:.2f} s cycle{each} every {z.sample_dt * 1000:.0f} ms, "
            f"x {x0:.3f}..{x1:.3f} m, y {y0:.3f}..{y1:.3f} m"]
+    cycles = dict(r.robot_cycles)
     for d in r.devices:
         whose = f", stopping robot {d.robot}" if d.robot else ""
         out.append(f"{d.device} ({d.type}{whose}): T = {d.response_time:.2f} + {d.stopping_time:.2f} s, {d.formula}")
@@ -37,7 +40,8 @@ def check_lines(r) -> list[str]:
             for q0, q1, dist in d.entries:
                 out.append(f"  open edge {_xy(q0)}-{_xy(q1)}: {dist:.3f} m to the hazard zone, "
                            f"needs {d.required:.3f} m: {_verdict(dist >= d.required - 1e-9)}")
-        out.append(f"  {d.device}: {d.actual:.3f} m >= {d.required:.3f} m? {_verdict(d.ok)}{_where(d.where, z.cycle)}")
+        where = _where(d.where, cycles.get(d.robot, z.cycle))
+        out.append(f"  {d.device}: {d.actual:.3f} m >= {d.required:.3f} m? {_verdict(d.ok)}{where}")
         if r.phase_fixed and math.isfinite(d.episode_actual) and d.episode_actual > d.actual + 5e-4:
             out.append(f"    (during one episode, t = 0..{r.episode:.2f} s from the cell's phase, "
                        f"the robot comes no closer than {d.episode_actual:.3f} m)")
@@ -51,7 +55,7 @@ def check_lines(r) -> list[str]:
     for p in open_:
         out.append(f"  panel {_xy(p.start)}-{_xy(p.end)} counts as open: {p.reason}")
     for a in (r.approach, *r.robot_approaches):
-        out += _approach_lines(a, z.cycle)
+        out += _approach_lines(a, cycles.get(a.robot, z.cycle))
     for rc in r.restarts:
         b = rc.behind
         out.append(f"{rc.device}: automatic restart after {rc.clear_time:g} s clear; a worker who crossed it stands "

@@ -125,6 +125,7 @@ class StaticCheck:
     phase_fixed: bool = True  # the worker arrives at the cell's own phase (human.arrival: fixed)
     restarts: tuple = ()  # RestartCheck of every device with an automatic restart
     robot_approaches: tuple[ApproachCheck, ...] = ()  # several robots: the undetected reach to robots 1..
+    robot_cycles: tuple[tuple[str, float], ...] = ()  # several robots: each one's cycle time [s]
 
     @property
     def ok(self) -> bool:
@@ -409,7 +410,8 @@ def check_cell(cell: Cell | str | Path, layout=None) -> StaticCheck:
         approach, more = _approach_check(spec, layout, zone, panels, lean, ARM_ALLOWANCE), ()
     return StaticCheck(spec.name, zone, devices, approach, panels, shoulder, float(body[L.B_ARM_LEN]),
                        episode_length(spec), spec.human.arrival == "fixed",
-                       _restart_checks(spec, layout, zone, panels, lean), more)
+                       _restart_checks(spec, layout, zone, panels, lean), more,
+                       tuple((p.name, float(p.trajectory.cycle)) for p in layout.robots) if more else ())
 
 
 def stops_robot(device, robot: str) -> bool:
