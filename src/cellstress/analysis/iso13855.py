@@ -45,7 +45,7 @@ from cellstress.analysis.plane import (
 )
 from cellstress.cell.load import Cell, load_cell
 from cellstress.core.records import ScanPlane, VerticalField
-from cellstress.devices.base import DeviceRecord
+from cellstress.devices.base import DeviceRecord, stops_robot
 from cellstress.human.body import WALK_BLOCK_HEIGHT
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
@@ -412,12 +412,6 @@ def check_cell(cell: Cell | str | Path, layout=None) -> StaticCheck:
                        episode_length(spec), spec.human.arrival == "fixed",
                        _restart_checks(spec, layout, zone, panels, lean), more,
                        tuple((p.name, float(p.trajectory.cycle)) for p in layout.robots) if more else ())
-
-
-def stops_robot(device, robot: str) -> bool:
-    """Whether ``device``'s stop stops the robot named ``robot`` (a device without ``stops`` stops every one)."""
-    stops = device.stops if isinstance(device, DeviceRecord) else None
-    return stops is None or robot in stops
 
 
 def _per_robot(spec, layout, shoulder: float, lean: float) -> tuple[tuple[DeviceCheck, ...], list[ApproachCheck]]:

@@ -23,6 +23,7 @@ from cellstress.core.io import MAX_INPUT_BYTES, InputFileError, read_input_bytes
 from cellstress.core.plane import point_segment_distance, polygon_distance
 from cellstress.core.protocols import Channels
 from cellstress.core.records import Channel
+from cellstress.devices.base import stops_of
 from cellstress.human.body import BODY_RADIUS, WALK_BLOCK_HEIGHT
 from cellstress.robot.model import load_robot, resolve_urdf, unknown_urdf_message
 
@@ -391,11 +392,12 @@ def _check_robot_names(cell: Cell) -> None:
             raise CellError(src, f"robots[{i}].name", f"robot names must be unique: robots[{names.index(n)}] is "
                                                      f"also named {n!r}")
     for i, d in enumerate(spec.devices):
-        for j, n in enumerate(d.stops or ()):
+        stops = stops_of(d) or ()
+        for j, n in enumerate(stops):
             if n not in names:
                 raise CellError(src, f"devices[{i}].stops[{j}]", f"no robot is named {n!r}; the robots are "
                                                                  f"{', '.join(names)}")
-            if n in d.stops[:j]:
+            if n in stops[:j]:
                 raise CellError(src, f"devices[{i}].stops[{j}]", f"names robot {n!r} twice")
         if len(names) > 1:
             for c in _channels(d):

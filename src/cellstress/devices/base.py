@@ -57,3 +57,15 @@ class DeviceRecord(Record):
     def warning_distance(self, stopping_time: float) -> IsoDistance | None:
         """ISO 13855 distance of the device's warning field (a channel that reduces the speed), if it has one."""
         return None
+
+
+def stops_of(device) -> tuple[str, ...] | None:
+    """The robot names a device's stop is limited to (``DeviceRecord.stops``); None: every robot (also for a
+    device kind that is not a ``DeviceRecord``)."""
+    return device.stops if isinstance(device, DeviceRecord) else None
+
+
+def stops_robot(device, robot: str) -> bool:
+    """Whether ``device``'s stop stops the robot named ``robot``."""
+    stops = stops_of(device)
+    return stops is None or robot in stops

@@ -8,6 +8,7 @@ static check.
 
 from __future__ import annotations
 
+from cellstress.devices.base import stops_robot
 from cellstress.searchers.result import DeviceTiming, Why
 
 
@@ -69,13 +70,13 @@ def explain(layout, records, unsafe_row: int) -> Why:
     robot = touched_robot(layout, records[unsafe_row])
     stopping_time = spec.robot.stopping_time if robot is None else robot.spec.stopping_time
     if len(layout.robots) > 1:
-        others = [d.name for d in spec.devices if d.stops is not None and robot.name not in d.stops
+        others = [d.name for d in spec.devices if not stops_robot(d, robot.name)
                   and any(d.name in r.devices for r in records[: unsafe_row + 1])]
         if others:
             note = f"{', '.join(others)} saw the worker but {'does' if len(others) == 1 else 'do'} not stop " \
                    f"robot {robot.name}"
             words = note if words is None else f"{note}; {words}"
-    stopping = {d.name for d in spec.devices if len(layout.robots) < 2 or d.stops is None or robot.name in d.stops}
+    stopping = {d.name for d in spec.devices if len(layout.robots) < 2 or stops_robot(d, robot.name)}
     response = {d.name: float(d.response_time) for d in spec.devices}
     saw: dict[str, float] = {}
     for r in records[: unsafe_row + 1]:

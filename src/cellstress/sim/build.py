@@ -12,6 +12,7 @@ from cellstress.cell.program import held_joints, robot_program
 from cellstress.cell.schema import ObstacleSpec, RobotSpec
 from cellstress.core.protocols import Channels
 from cellstress.core.records import Channel, ScanPlane, VerticalField
+from cellstress.devices.base import stops_of
 from cellstress.human.actions import action_table
 from cellstress.human.body import BodyDimensions
 from cellstress.human.reach import ReachField, reach_field
@@ -267,7 +268,7 @@ def _device_robots(spec) -> np.ndarray:
     names = [r.name for r in spec.robots]
     masks = []
     for d in spec.devices:
-        stops = names if d.stops is None else d.stops
+        stops = names if stops_of(d) is None else stops_of(d)
         mask = sum(1 << names.index(n) for n in stops)
         n_chan = len(d.channels()) if isinstance(d, Channels) else len(tuple(d.primitives()))
         masks.extend([mask] * n_chan)
