@@ -61,11 +61,12 @@ def layout_figure(layout: Layout, size: D.FigureSize = StillOptions().layout, ti
 def _draw_distances(ax, static: StaticCheck) -> list:
     """ISO 13855 dimension lines: green where the layout gives the required distance S, red where it does not;
     the closest undetected reach (ISO 13857) likewise."""
-    lines = [(d.where, f"{d.device}: S {d.required:.2f} m needed, {d.actual:.2f} m here", d.ok)
-             for d in static.devices if d.where is not None]
-    a = static.approach
-    if a.where is not None and math.isfinite(a.distance):
-        lines.append((a.where, f"reach around: {a.distance:.2f} m, {a.arm_allowance:.2f} m needed", a.ok))
+    lines = [(d.where, f"{d.device}{' -> ' + d.robot if d.robot else ''}: S {d.required:.2f} m needed, "
+              f"{d.actual:.2f} m here", d.ok) for d in static.devices if d.where is not None]
+    for a in (static.approach, *static.robot_approaches):  # (several robots: the reach to each one's zone)
+        if a.where is not None and math.isfinite(a.distance):
+            whose = f" to {a.robot}" if a.robot else ""
+            lines.append((a.where, f"reach around{whose}: {a.distance:.2f} m, {a.arm_allowance:.2f} m needed", a.ok))
     placed: list[tuple[float, float]] = []
     for where, text, ok in lines:
         color = OK_COLOR if ok else FAIL_COLOR
