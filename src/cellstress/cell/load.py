@@ -389,8 +389,9 @@ def _check_robot_names(cell: Cell) -> None:
     names = [r.name for r in spec.robots]
     for i, n in enumerate(names):
         if n in names[:i]:
+            hint = " (give each robot a name)" if n == "robot" else ""
             raise CellError(src, f"robots[{i}].name", f"robot names must be unique: robots[{names.index(n)}] is "
-                                                     f"also named {n!r}")
+                                                     f"also named {n!r}{hint}")
     for i, d in enumerate(spec.devices):
         stops = stops_of(d) or ()
         for j, n in enumerate(stops):
