@@ -2,6 +2,7 @@
 searched for a hazard with a large budget.
 
     python benchmarks/new_cells.py [--seeds 10] [--budget 200] [--twin-budget 1000] [--twin-seeds 3]
+                                   [--cells palletizing,two-robots]
 
 Prints one Markdown row per cell and searcher: runs that found a hazard, mean and largest episodes to the first
 hazard (a run without one counts as the budget); for a twin, hazardous episodes over whole budgets.
@@ -15,7 +16,7 @@ import statistics
 from cellstress.searchers import search
 from cellstress.sim.simulator import Simulator
 
-PAIRS = (("palletizing", "palletizing-fixed"),)
+PAIRS = (("palletizing", "palletizing-fixed"), ("two-robots", "two-robots-fixed"))
 SEARCHERS = ("plan", "evolve", "random")
 
 
@@ -25,10 +26,12 @@ def main() -> None:
     ap.add_argument("--budget", type=int, default=200)
     ap.add_argument("--twin-budget", type=int, default=1000)
     ap.add_argument("--twin-seeds", type=int, default=3)
+    ap.add_argument("--cells", default=",".join(f for f, _ in PAIRS), help="the flawed cells of the pairs to run")
     args = ap.parse_args()
+    chosen = args.cells.split(",")
     print("| cell | searcher | runs | found | mean episodes | max episodes | hazardous episodes |")
     print("|---|---|---|---|---|---|---|")
-    for flawed, twin in PAIRS:
+    for flawed, twin in (p for p in PAIRS if p[0] in chosen):
         sim = Simulator(flawed)
         for s in SEARCHERS:
             eps = []

@@ -155,7 +155,7 @@ def test_check_iso13855_user_error_is_one_line(capsys, monkeypatch) -> None:
     from cellstress.analysis import iso13855
     from cellstress.core.errors import CellError
 
-    def check_cell(cell):
+    def check_cell(cell, layout=None):
         raise CellError(cell.source, "devices[0]", "too close")
 
     monkeypatch.setattr(iso13855, "check_cell", check_cell)
@@ -305,7 +305,8 @@ def test_cli_runner_user_error_is_one_line() -> None:
         "error: /no/such/cell.yaml: no such file, and not a built-in cell "
         "(baseline, s1-scanner-width, s2-elbow-intrusion, s3-fence-gap, all-flaws, s2-deceptive, restart-auto, "
         "restart-manual, warning-field-short, warning-field-ok, mat-short, mat-ok, palletizing, palletizing-fixed, "
-        "door-unlocked, door-locked, muting-long, muting-ok)"
+        "door-unlocked, door-locked, muting-long, muting-ok, "
+        "two-robots, two-robots-fixed)"
     )
     assert result.stdout == ""
 

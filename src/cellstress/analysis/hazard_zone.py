@@ -97,27 +97,44 @@ def closest_on_zone(zone: HazardZone, point, hazard_point, i: int) -> Closest:
                    zone.part_names[int(zone.part[i])], round(float(zone.t[i]), 3))
 
 
-def hazard_zone(layout, sample_dt: float = SAMPLE_DT) -> HazardZone:
-    """Sample the robot capsules over one cycle (before any stop) into floor stadiums."""
+def hazard_zone(layout, sample_dt: float = SAMPLE_DT, robot: int | None = None) -> HazardZone:
+    """Sample the robot capsules over one cycle (before any stop) into floor stadiums. In a cell of several
+    robots: every robot's, each over its own cycle (``cycle`` is robot 0's), or robot ``robot``'s only."""
     P = layout.params
     W = K.make_work(P)
-    cycle = float(P.scal[L.C_CYCLE])
-    ts = np.arange(0.0, cycle, sample_dt)
-    nc = P.cap_r.shape[0]
-    ra = np.empty((len(ts), nc, 3))
-    rb = np.empty((len(ts), nc, 3))
-    for k, t in enumerate(ts):
-        K.robot_live(P, float(t), np.inf, W)
-        ra[k] = W.ra
-        rb[k] = W.rb
-    a = ra[:, :, :2].reshape(-1, 2)
-    b = rb[:, :, :2].reshape(-1, 2)
-    r = np.broadcast_to(P.cap_r, (len(ts), nc)).reshape(-1)
-    tt = np.repeat(ts, nc)
-    part = np.tile(np.arange(nc), len(ts))
-    key = np.round(np.concatenate([a, b, r[:, None]], axis=1) * 1e6).astype(np.int64)  # drops only exact repeats
+    nx = P.x_scal.shape[0]
+    robots = range(nx + 1) if robot is None else (robot,)
+    parts = []
+    for r in robots:
+        scal = P.scal if r == 0 else P.x_scal[r - 1]
+        ts = np.arange(0.0, float(scal[L.C_CYCLE]), sample_dt)
+        c0 = 0 if r == 0 else int(P.x_cap0[r - 1])
+        caps = np.arange(c0, c0 + (P.cap_joint.shape[0] if r == 0 else int(P.x_ncap[r - 1])))
+        ra = np.empty((len(ts), len(caps), 3))
+        rb = np.empty((len(ts), len(caps), 3))
+        if r > 0:  # robots 1.. posed at t = k * sample_dt, without the pre-stop table (kernels.other_robots)
+            x_scal = P.x_scal.copy()
+            x_scal[:, L.C_DT] = sample_dt
+            Pr = P._replace(x_scal=x_scal, pre_xv=np.zeros((0, nx)))
+            state = np.full(L.NS, np.inf)
+        for k, t in enumerate(ts):
+            if r == 0:
+                K.robot_live(P, float(t), np.inf, W)
+            else:
+                K.other_robots(Pr, np.int64(k), state, W)
+            ra[k] = W.ra[caps]
+            rb[k] = W.rb[caps]
+        parts.append((ts, caps, ra, rb))
+    a = np.concatenate([ra[:, :, :2].reshape(-1, 2) for _, _, ra, _ in parts])
+    b = np.concatenate([rb[:, :, :2].reshape(-1, 2) for _, _, _, rb in parts])
+    r_ = np.concatenate([np.broadcast_to(P.cap_r[caps], (len(ts), len(caps))).reshape(-1)
+                         for ts, caps, _, _ in parts])
+    tt = np.concatenate([np.repeat(ts, len(caps)) for ts, caps, _, _ in parts])
+    part = np.concatenate([np.tile(caps, len(ts)) for ts, caps, _, _ in parts])
+    key = np.round(np.concatenate([a, b, r_[:, None]], axis=1) * 1e6).astype(np.int64)  # drops only exact repeats
     _, first = np.unique(key, axis=0, return_index=True)
     first = np.sort(first)
     return HazardZone(np.ascontiguousarray(a[first]), np.ascontiguousarray(b[first]),
-                      np.ascontiguousarray(r[first]), tt[first], part[first],
-                      tuple(c.name for c in layout.capsules), cycle, sample_dt, len(ts))
+                      np.ascontiguousarray(r_[first]), tt[first], part[first],
+                      tuple(c.name for c in layout.capsules), float(P.scal[L.C_CYCLE]), sample_dt,
+                      len(parts[0][0]))

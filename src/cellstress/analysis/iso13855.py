@@ -25,11 +25,12 @@ The reasoning behind every number is in docs/cells.md. In short:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
+from cellstress.analysis.check_text import check_lines
 from cellstress.analysis.hazard_zone import Closest, HazardZone, closest_on_zone, hazard_zone, segment_to_zone
 from cellstress.analysis.muting import muting_checks
 from cellstress.analysis.plane import (
@@ -45,7 +46,7 @@ from cellstress.analysis.plane import (
 )
 from cellstress.cell.load import Cell, load_cell
 from cellstress.core.records import DoorLeaf, ScanPlane, VerticalField
-from cellstress.devices.base import DeviceRecord
+from cellstress.devices.base import DeviceRecord, stops_robot
 from cellstress.devices.guard_door import GuardDoor
 from cellstress.human.body import WALK_BLOCK_HEIGHT
 from cellstress.sim import kernels as K
@@ -79,6 +80,7 @@ class DeviceCheck:
     # from the cell's phase): what a search can actually meet; for information, ISO uses the whole cycle
     episode_actual: float = math.inf
     field_edges: bool = False  # the entries are the open edges of a scan plane's field (listed one by one)
+    robot: str = ""  # in a cell of several robots: the robot whose stopping time and hazard zone this row uses
     note: str = ""  # a further line of the device kind's own (a guard door: its access time, ISO 14119)
 
 
@@ -109,6 +111,8 @@ class ApproachCheck:
     distance: float  # m, shortest arm path from an undetected shoulder position to the zone (inf: none)
     where: Closest | None
     ok: bool
+    robot: str = ""  # in a cell of several robots: the robot whose hazard zone it measures to
+    guards: tuple[str, ...] = ()  # ... and the devices that stop that robot (the others do not count)
 
 
 @dataclass(frozen=True)
@@ -123,23 +127,28 @@ class StaticCheck:
     episode: float  # s, length of one search episode
     phase_fixed: bool = True  # the worker arrives at the cell's own phase (human.arrival: fixed)
     restarts: tuple = ()  # RestartCheck of every device with an automatic restart
+    robot_approaches: tuple[ApproachCheck, ...] = ()  # several robots: the undetected reach to robots 1..
+    robot_cycles: tuple[tuple[str, float], ...] = ()  # several robots: each one's cycle time [s]
     mutings: tuple = ()  # analysis.muting.MutingCheck of every muted light curtain
 
     @property
     def ok(self) -> bool:
-        return all(d.ok for d in self.devices) and self.approach.ok and all(r.ok for r in self.restarts + self.mutings)
+        return (all(d.ok for d in self.devices) and self.approach.ok
+                and all(r.ok for r in self.restarts + self.mutings) and all(a.ok for a in self.robot_approaches))
 
     def failures(self) -> list[str]:
-        """Names of the failed checks: device names, 'undetected-reach', 'DEVICE-restart', 'DEVICE-muting'."""
-        out = [d.device for d in self.devices if not d.ok]
-        if not self.approach.ok:
-            out.append("undetected-reach")
+        """Names of the failed checks: device names, 'undetected-reach', 'DEVICE-restart', 'DEVICE-muting' (in a
+        cell of several robots, with ':ROBOT' after a device's or the reach check's name)."""
+        out = [d.device + (f":{d.robot}" if d.robot else "") for d in self.devices if not d.ok]
+        for a in (self.approach, *self.robot_approaches):
+            if not a.ok:
+                out.append("undetected-reach" + (f":{a.robot}" if a.robot else ""))
         out += [f"{r.device}-restart" for r in self.restarts if not r.ok]
         out += [f"{m.device}-muting" for m in self.mutings if not m.ok]
         return out
 
     def lines(self) -> list[str]:
-        return _lines(self)
+        return check_lines(self)
 
 
 # ---- the cell's parts -------------------------------------------------------------------------------------
@@ -193,8 +202,10 @@ def episode_length(spec) -> float:
     return sim.dt * sim.steps_per_action * sim.actions_per_episode
 
 
-def _device_checks(spec, zone: HazardZone) -> tuple[DeviceCheck, ...]:
-    stop = spec.robot.stopping_time
+def _device_checks(spec, zone: HazardZone, robot: str = "") -> tuple[DeviceCheck, ...]:
+    """Every device's ISO 13855 row; with ``robot`` (a cell of several robots), for that robot: its stopping time,
+    its hazard zone (``zone``), and ``spec.devices`` the devices that stop it."""
+    stop = spec.robot.stopping_time if not robot else next(r for r in spec.robots if r.name == robot).stopping_time
     t_ep = episode_length(spec)
     fl = spec.floor
     floor_edges = [((fl.xmin, fl.ymin), (fl.xmax, fl.ymin)), ((fl.xmax, fl.ymin), (fl.xmax, fl.ymax)),
@@ -211,7 +222,8 @@ def _device_checks(spec, zone: HazardZone) -> tuple[DeviceCheck, ...]:
         note = d.access_note(actual, stop) if isinstance(d, GuardDoor) else ""
         out.append(DeviceCheck(d.name, d.type, d.response_time, stop, iso.T, iso.K, iso.C, required,
                                actual, bool(actual >= required - 1e-9), iso.formula, where,
-                               tuple(entries), ep, any(isinstance(p, ScanPlane) for p in d.primitives()), note))
+                               tuple(entries), ep, any(isinstance(p, ScanPlane) for p in d.primitives()), robot,
+                               note))
         warn = d.warning_distance(stop) if isinstance(d, DeviceRecord) else None
         if warn is not None:  # the warning field: measured like a field, against its own distance
             out.append(_warning_check(d, warn, stop, covers, zone, t_ep))
@@ -395,13 +407,36 @@ def check_cell(cell: Cell | str | Path, layout=None) -> StaticCheck:
     body = layout.params.body
     shoulder = float(body[L.B_HIP_Z] + body[L.B_SHOULDER_RISE])
     zone = hazard_zone(layout)
-    devices = _device_checks(spec, zone)
     panels = _fence_panels(spec, zone, shoulder, ARM_ALLOWANCE)
     lean = lean_reach(layout)
-    approach = _approach_check(spec, layout, zone, panels, lean, ARM_ALLOWANCE)
+    if len(spec.robots) > 1:
+        devices, approaches = _per_robot(spec, layout, shoulder, lean)
+        approach, more = approaches[0], approaches[1:]
+    else:
+        devices = _device_checks(spec, zone)
+        approach, more = _approach_check(spec, layout, zone, panels, lean, ARM_ALLOWANCE), ()
     return StaticCheck(spec.name, zone, devices, approach, panels, shoulder, float(body[L.B_ARM_LEN]),
                        episode_length(spec), spec.human.arrival == "fixed",
-                       _restart_checks(spec, layout, zone, panels, lean), muting_checks(spec))
+                       _restart_checks(spec, layout, zone, panels, lean), more,
+                       tuple((p.name, float(p.trajectory.cycle)) for p in layout.robots) if more else (),
+                       muting_checks(spec))
+
+
+def _per_robot(spec, layout, shoulder: float, lean: float) -> tuple[tuple[DeviceCheck, ...], list[ApproachCheck]]:
+    """A cell of several robots, robot by robot: each device that stops the robot, with the robot's stopping
+    time, measured to the robot's own hazard zone; and the undetected reach to that zone, where a device that
+    does not stop the robot is no protection (the worker walks through it: a curtain wired to robot a only
+    leaves robot b open, and this check fails for b)."""
+    devices: list[DeviceCheck] = []
+    approaches = []
+    for r, rs in enumerate(spec.robots):
+        z = hazard_zone(layout, robot=r)
+        mine = tuple(d for d in spec.devices if stops_robot(d, rs.name))
+        sr = spec.model_copy(update={"devices": mine})
+        devices += _device_checks(sr, z, rs.name)
+        a = _approach_check(sr, layout, z, _fence_panels(spec, z, shoulder, ARM_ALLOWANCE), lean, ARM_ALLOWANCE)
+        approaches.append(replace(a, robot=rs.name, guards=tuple(d.name for d in mine)))
+    return tuple(devices), approaches
 
 
 def device_distances(cell: Cell | str | Path, layout=None) -> list[DeviceCheck]:
@@ -412,77 +447,3 @@ def device_distances(cell: Cell | str | Path, layout=None) -> list[DeviceCheck]:
 def static_check(cell: Cell | str | Path, layout=None) -> list[str]:
     """Lines for ``cellstress check`` to print."""
     return check_cell(cell, layout).lines()
-
-
-# ---- text -------------------------------------------------------------------------------------------------
-def _xy(p) -> str:
-    return f"({p[0]:.2f}, {p[1]:.2f})"
-
-
-def _verdict(ok: bool) -> str:
-    return "ok" if ok else "FAIL"
-
-
-def _where(w: Closest | None, cycle: float) -> str:
-    if w is None:
-        return ""
-    return (f" at {_xy(w.point)} -> {_xy(w.hazard_point)}: {w.robot_part} at t = {w.t:.2f} s "
-            f"(episode time, mod {cycle:.2f} s)")
-
-
-def _lines(r: StaticCheck) -> list[str]:
-    z = r.zone
-    x0, x1, y0, y1 = z.extent()
-    out = [f"hazard zone: robot capsules over one {z.cycle:.2f} s cycle every {z.sample_dt * 1000:.0f} ms, "
-           f"x {x0:.3f}..{x1:.3f} m, y {y0:.3f}..{y1:.3f} m"]
-    for d in r.devices:
-        out.append(f"{d.device} ({d.type}): T = {d.response_time:.2f} + {d.stopping_time:.2f} s, {d.formula}")
-        if d.field_edges and not d.entries:
-            out.append("  no open field edge: every edge lies along a fence, the table or the floor's edge")
-        if d.field_edges:
-            for q0, q1, dist in d.entries:
-                out.append(f"  open edge {_xy(q0)}-{_xy(q1)}: {dist:.3f} m to the hazard zone, "
-                           f"needs {d.required:.3f} m: {_verdict(dist >= d.required - 1e-9)}")
-        out.append(f"  {d.device}: {d.actual:.3f} m >= {d.required:.3f} m? {_verdict(d.ok)}{_where(d.where, z.cycle)}")
-        if r.phase_fixed and math.isfinite(d.episode_actual) and d.episode_actual > d.actual + 5e-4:
-            out.append(f"    (during one episode, t = 0..{r.episode:.2f} s from the cell's phase, "
-                       f"the robot comes no closer than {d.episode_actual:.3f} m)")
-        if d.note:
-            out.append(f"  {d.note}")
-    closed = [p for p in r.fences if p.closed]
-    open_ = [p for p in r.fences if not p.closed]
-    if closed:
-        p = min(closed, key=lambda q: q.over_top)
-        out.append(f"fences: {len(closed)} of {len(r.fences)} panels close the way; nearest reach over a top: "
-                   f"{p.top:.2f} - {r.shoulder_height:.3f} (shoulder) + {p.to_hazard:.3f} = {p.over_top:.3f} m "
-                   f">= {ARM_ALLOWANCE:.2f} m ({_xy(p.start)}-{_xy(p.end)})")
-    for p in open_:
-        out.append(f"  panel {_xy(p.start)}-{_xy(p.end)} counts as open: {p.reason}")
-    a = r.approach
-    margins = [f">{m:.2f} m from {what}" for m, what in ((a.scanner_margin, "scanner fields"),
-                                                         (a.curtain_margin, "curtains")) if m is not None]
-    where = f"stand {' and '.join(margins)}" if margins else "no detection zone to keep away from"
-    head = (f"undetected reach from {_xy(a.start)}: {where} ({a.undetected_area:.1f} m^2), lean {a.lean:.3f} m, "
-            f"arm {a.arm_allowance:.2f} m")
-    out.append(head)
-    if a.start_detected:
-        out.append("  the start point is inside a detection zone: no undetected approach")
-    elif a.where is None:
-        out.append(f"  the hazard zone cannot be reached around the fences: {_verdict(a.ok)}")
-    else:
-        out.append(f"  closest: stand at {_xy(a.stand)}, shoulder at {_xy(a.where.point)}, arm path "
-                   f"{a.distance:.3f} m >= {a.arm_allowance:.2f} m? {_verdict(a.ok)}{_where(a.where, z.cycle)}")
-    for rc in r.restarts:
-        b = rc.behind
-        out.append(f"{rc.device}: automatic restart after {rc.clear_time:g} s clear; a worker who crossed it stands "
-                   f"unseen on {b.undetected_area:.1f} m^2 next to it")
-        if b.where is None:
-            out.append(f"  from there the hazard zone cannot be reached: {_verdict(rc.ok)}")
-        else:
-            out.append(f"  closest: stand at {_xy(b.stand)}, shoulder at {_xy(b.where.point)}, arm path "
-                       f"{b.distance:.3f} m >= {b.arm_allowance:.2f} m? {_verdict(rc.ok)}{_where(b.where, z.cycle)}"
-                       + ("" if rc.ok else ": the robot restarts while the worker stands unseen within reach"))
-    out += [m.line() for m in r.mutings]
-    fails = r.failures()
-    out.append("result: pass" if not fails else f"result: FAIL ({', '.join(fails)})")
-    return out

@@ -21,13 +21,17 @@ from cellstress.core import registry
 from cellstress.core.errors import CellError, CellstressError
 from cellstress.core.io import MAX_INPUT_BYTES, InputFileError, read_input_bytes
 from cellstress.core.plane import point_segment_distance, polygon_distance
+from cellstress.core.protocols import Channels
+from cellstress.core.records import Channel
+from cellstress.devices.base import stops_of
 from cellstress.human.body import BODY_RADIUS, WALK_BLOCK_HEIGHT
 from cellstress.robot.model import load_robot, resolve_urdf, unknown_urdf_message
 
 BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap", "all-flaws",
                                   "s2-deceptive", "restart-auto", "restart-manual", "warning-field-short",
                                   "warning-field-ok", "mat-short", "mat-ok", "palletizing", "palletizing-fixed",
-                                  "door-unlocked", "door-locked", "muting-long", "muting-ok")
+                                  "door-unlocked", "door-locked", "muting-long", "muting-ok",
+                                  "two-robots", "two-robots-fixed")
 
 
 @dataclass(frozen=True)
@@ -339,28 +343,74 @@ def load_cell(name_or_path: str | Path) -> Cell:
 
 def check_geometry(cell: Cell) -> None:
     """Checks that need more than one field: the URDF, the robot's program against its joints and their
-    position and velocity limits, the robot's cycle time, the start pose and every named start point."""
-    spec, src = cell.spec, cell.source
-    urdf = resolve_urdf(spec.robot.urdf, cell.files_dir)
-    if not urdf.is_file():
-        raise CellError(src, "robot.urdf", unknown_urdf_message(spec.robot.urdf, urdf))
-    try:
-        robot = load_robot(urdf)
-    except CellstressError as exc:
-        raise CellError(src, "robot.urdf", str(exc)) from None
-    except Exception as exc:  # pinocchio raises plain RuntimeError/ValueError for unreadable URDFs
-        raise CellError(src, "robot.urdf", f"pinocchio cannot read it: {str(exc).splitlines()[0]}") from None
-    robot_program(src, robot, spec.robot, cell.files_dir)
-    caps = spec.robot.capsules if spec.robot.capsules != "auto" else ()
-    for i, c in enumerate(tuple(caps) + spec.robot.extra_capsules):
-        if c.link not in robot.link_joint:
-            field = (f"robot.capsules[{i}].link" if i < len(caps)
-                     else f"robot.extra_capsules[{i - len(caps)}].link")
-            raise CellError(src, field, f"the robot has no link {c.link!r}; its links are "
-                                        f"{', '.join(sorted(robot.link_joint))}")
+    position and velocity limits, the robot's cycle time, the robots' names and the devices' ``stops``, the start
+    pose and every named start point."""
+    spec = cell.spec
+    several = "robots" in spec.model_fields_set  # a robots list, even of one: its errors name robots[i]
+    for i, rs in enumerate(spec.robots):
+        _check_robot(cell, rs, f"robots[{i}]" if several else "robot")
+    _check_robot_names(cell)
     _check_standing_point(cell, "human.start.xy", spec.human.start.xy)
     for i, s in enumerate(spec.human.starts):
         _check_standing_point(cell, f"human.starts[{i}].xy", s.xy)
+
+
+def _check_robot(cell: Cell, rs, where: str) -> None:
+    """One robot's URDF, program and capsules; errors name ``where`` (robot, or robots[i]) as the field."""
+    src = cell.source
+    urdf = resolve_urdf(rs.urdf, cell.files_dir)
+    if not urdf.is_file():
+        raise CellError(src, f"{where}.urdf", unknown_urdf_message(rs.urdf, urdf))
+    try:
+        robot = load_robot(urdf)
+    except CellstressError as exc:
+        raise CellError(src, f"{where}.urdf", str(exc)) from None
+    except Exception as exc:  # pinocchio raises plain RuntimeError/ValueError for unreadable URDFs
+        raise CellError(src, f"{where}.urdf", f"pinocchio cannot read it: {str(exc).splitlines()[0]}") from None
+    try:
+        robot_program(src, robot, rs, cell.files_dir)
+    except CellError as exc:  # the program's messages name the field from "robot."
+        if where == "robot" or not exc.field.startswith("robot."):
+            raise
+        raise CellError(src, where + exc.field.removeprefix("robot"), exc.problem) from None
+    caps = rs.capsules if rs.capsules != "auto" else ()
+    for i, c in enumerate(tuple(caps) + rs.extra_capsules):
+        if c.link not in robot.link_joint:
+            field = (f"{where}.capsules[{i}].link" if i < len(caps)
+                     else f"{where}.extra_capsules[{i - len(caps)}].link")
+            raise CellError(src, field, f"the robot has no link {c.link!r}; its links are "
+                                        f"{', '.join(sorted(robot.link_joint))}")
+
+
+def _check_robot_names(cell: Cell) -> None:
+    """Robot names unique; each device's ``stops`` names robots of the cell, each once. Several robots do not
+    (yet) combine with a device that restarts the robots automatically or slows them (a warning field): the
+    kernel keeps the restart and speed-reduction state for the first robot only."""
+    spec, src = cell.spec, cell.source
+    names = [r.name for r in spec.robots]
+    for i, n in enumerate(names):
+        if n in names[:i]:
+            hint = " (give each robot a name)" if n == "robot" else ""
+            raise CellError(src, f"robots[{i}].name", f"robot names must be unique: robots[{names.index(n)}] is "
+                                                     f"also named {n!r}{hint}")
+    for i, d in enumerate(spec.devices):
+        stops = stops_of(d) or ()
+        for j, n in enumerate(stops):
+            if n not in names:
+                raise CellError(src, f"devices[{i}].stops[{j}]", f"no robot is named {n!r}; the robots are "
+                                                                 f"{', '.join(names)}")
+            if n in stops[:j]:
+                raise CellError(src, f"devices[{i}].stops[{j}]", f"names robot {n!r} twice")
+        if len(names) > 1:
+            for c in _channels(d):
+                if c.speed != 0.0 or c.clear_time != float("inf"):
+                    what = "a warning field" if c.speed != 0.0 else "an automatic restart"
+                    raise CellError(src, f"devices[{i}]", f"has {what}; a cell with several robots takes devices "
+                                                          "whose stops are manual only (not implemented yet)")
+
+
+def _channels(d) -> tuple[Channel, ...]:
+    return d.channels() if isinstance(d, Channels) else ()
 
 
 def _check_standing_point(cell: Cell, where: str, xy) -> None:

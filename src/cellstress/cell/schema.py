@@ -47,6 +47,11 @@ MAX_WAYPOINTS = 256
 MAX_PANELS = 1024  # fence panels in a cell: the simulator checks the near ones at every step
 MAX_COUNT = 32  # devices, start points, table polygons
 MAX_CAPSULES = 64
+MAX_ROBOTS = 4  # robots in a cell: each adds its joints, capsules and stop latch to every step
+
+# A robot's name: it lands in HTML, CSV and terminal output (escaped there) and in device ``stops`` lists, never
+# in a path, so an identifier.
+RobotName = Annotated[str, Field(min_length=1, max_length=32, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")]
 
 JointAngle = Annotated[float, Field(ge=-3600.0, le=3600.0, allow_inf_nan=False)]  # then the URDF's limits
 
@@ -187,6 +192,10 @@ CapsulesField = Annotated[
 
 class RobotSpec(Record):
     """The robot: a serial chain from a URDF, placed in the cell, with its collision capsules and its program."""
+
+    name: RobotName = "robot"
+    """The robot's name (letters, digits, ``_``; not starting with a digit): devices name the robots they stop
+    by it (``stops``) and a hazard names the robot it touched. Unique among ``robots``."""
 
     urdf: Annotated[str, Field(min_length=1, max_length=1000, pattern=r"^[^\x00]+$")] = "ur10"
     """A robot of example-robot-data by its short name (ur3, ur5, ur10, ur3-gripper, ur5-gripper, panda,
@@ -369,8 +378,11 @@ class CellSpec(Record):
     """The cell's name, shown in outputs (printable, one line)."""
     description: Annotated[str, Field(max_length=10_000)] = ""
     """Free text; its first sentence is shown by ``cellstress cells`` and ``check``."""
-    robot: RobotSpec
-    """The robot."""
+    robot: RobotSpec | None = None
+    """The robot (a cell has ``robot`` or ``robots``, not both): the same as ``robots`` with one entry."""
+    robots: tuple[RobotSpec, ...] = Field((), max_length=MAX_ROBOTS)
+    """Several robots, each with its own program and stopping time, names unique (at most 4). Read back, it
+    always holds every robot of the cell (``robot`` alone: that one), and ``robot`` is its first."""
     table: TableSpec | None = None
     """The work table (an obstacle of one height; absent: no table)."""
     obstacles: tuple[ObstacleSpec, ...] = Field((), max_length=MAX_COUNT)
@@ -387,6 +399,18 @@ class CellSpec(Record):
     """What is unsafe, tagged by its ``type``; absent: contact-while-moving (the paper's)."""
     simulation: SimulationSpec = SimulationSpec()
     """Time step and episode length."""
+
+    @model_validator(mode="after")
+    def _robot_or_robots(self) -> CellSpec:
+        if (self.robot is None) == (not self.robots):
+            raise ValueError("give exactly one of robot (one robot) and robots (a list of robots)"
+                             + (", not both" if self.robots else ""))
+        # (the two names always agree afterwards: every reader may take spec.robots, or spec.robot for the first)
+        if self.robot is None:
+            object.__setattr__(self, "robot", self.robots[0])
+        else:
+            object.__setattr__(self, "robots", (self.robot,))
+        return self
 
     @field_validator("devices")
     @classmethod

@@ -16,62 +16,24 @@ def check(
 
     Exit code 0 if the static check passes, 1 if it fails (a gate for a design in CI), 2 for a file that is not
     a valid cell."""
-    import numpy as np
-
     from cellstress.analysis.iso13855 import check_cell
     from cellstress.cell.load import BUILTIN_CELLS, builtin_file, load_cell
-    from cellstress.cell.program import robot_program
-    from cellstress.robot.capsules import declared_capsule, fitted_capsules
-    from cellstress.robot.model import load_robot, resolve_urdf
-    from cellstress.sim.build import pedestal
+    from cellstress.sim.build import build_layout
 
     with spinner_while_compiling(), user_errors():
         c = load_cell(cell)
         spec = c.spec
-        urdf = resolve_urdf(spec.robot.urdf, c.files_dir)
-        robot = load_robot(urdf)
-        if spec.robot.capsules == "auto":
-            caps = list(fitted_capsules(robot))
-            cap_kind = "fitted to the collision meshes"
-        else:
-            caps = [declared_capsule(robot, k.link, k.link, k.p0, k.p1, k.radius)
-                    for k in spec.robot.capsules]
-            cap_kind = "declared"
-        n_own = len(caps)
-        for i, k in enumerate(spec.robot.extra_capsules):
-            caps.append(declared_capsule(robot, f"{k.link}#extra{i}", k.link, k.p0, k.p1, k.radius))
-        task = spec.robot.task
-        traj = robot_program(c.source, robot, spec.robot, c.files_dir)
-        static = check_cell(c)
+        layout = build_layout(c)
+        static = check_cell(c, layout)
 
     out = say
     where = f"built-in: {builtin_file(cell)}" if cell in BUILTIN_CELLS else f"file: {c.source}"
     out(f"cell        {spec.name}  ({where}, sha256 {c.sha256[:12]})")
     if spec.description:
         out(f"            {first_sentence(spec.description)}")
-    base = spec.robot.base
-    out(f"robot       {spec.robot.urdf} -> {urdf}")
-    n_mimic = int((robot.mimic_master >= 0).sum())
-    follow = [f"{n} {what}" for n, what in ((len(spec.robot.hold), "held"), (n_mimic, "mimic")) if n]
-    joints = f"{robot.n_joints} joints" + (f" ({', '.join(follow)})" if follow else "")
-    out(f"            {joints}, base at ({', '.join(num(v) for v in base.xyz)}) "
-        f"yaw {num(base.yaw_deg)} deg, stopping time {num(spec.robot.stopping_time)} s")
-    extra = f" + {len(caps) - n_own} extra" if len(caps) > n_own else ""
-    out(f"capsules    {len(caps)} ({n_own} {cap_kind}{extra})")
-    for k in caps:
-        length = float(np.linalg.norm(np.subtract(k.p1, k.p0)))
-        out(f"            {k.name:<18} on joint {k.joint:>2}  radius {k.radius:.3f} m  length {length:.3f} m")
-    if task.trajectory_csv:
-        out(f"task        trajectory file {task.trajectory_csv}, {traj.n_segments + 1} rows, linear moves, "
-            f"phase {num(task.phase)} s, cycle time {traj.cycle:.2f} s")
-    else:
-        what = f"{len(task.poses)} tool poses of {task.tool_frame}" if task.poses else \
-            f"{len(task.waypoints_deg)} waypoints"
-        dwell = "per waypoint" if task.dwells else f"{num(task.dwell)} s"
-        scale = "per move" if task.speed_scales else num(task.speed_scale)
-        out(f"task        {what}, dwell {dwell}, speed scale {scale}, phase {num(task.phase)} s, "
-            f"cycle time {traj.cycle:.2f} s")
-    obstacles = spec.solid_obstacles() + tuple(p for p in (pedestal(spec, robot),) if p is not None)
+    for part in layout.robots:
+        _robot_lines(part, c.files_dir, len(layout.robots) > 1)
+    obstacles = layout.obstacles
     out(f"obstacles   {len(obstacles)}" + ("" if obstacles else " (nothing on the floor)"))
     for o in obstacles:
         out(f"            {o.name:<18} height {num(o.height)} m, footprint of {len(o.footprint())} corners")
@@ -100,3 +62,38 @@ def check(
     else:
         out(f"FAIL: the cell file is valid, the static check fails ({', '.join(static.failures())})")
         raise typer.Exit(1)
+
+
+def _robot_lines(part, files_dir, several: bool) -> None:
+    """The robot, its capsules and its program (in a cell of several robots, each headed by its name)."""
+    import numpy as np
+
+    from cellstress.robot.model import resolve_urdf
+
+    out, rs, robot, caps, traj = say, part.spec, part.model, part.capsules, part.trajectory
+    urdf = resolve_urdf(rs.urdf, files_dir)
+    n_own = len(caps) - len(rs.extra_capsules)
+    cap_kind = "fitted to the collision meshes" if rs.capsules == "auto" else "declared"
+    task = rs.task
+    base = rs.base
+    out(f"robot       {rs.name + ': ' if several else ''}{rs.urdf} -> {urdf}")
+    n_mimic = int((robot.mimic_master >= 0).sum())
+    follow = [f"{n} {what}" for n, what in ((len(rs.hold), "held"), (n_mimic, "mimic")) if n]
+    joints = f"{robot.n_joints} joints" + (f" ({', '.join(follow)})" if follow else "")
+    out(f"            {joints}, base at ({', '.join(num(v) for v in base.xyz)}) "
+        f"yaw {num(base.yaw_deg)} deg, stopping time {num(rs.stopping_time)} s")
+    extra = f" + {len(caps) - n_own} extra" if len(caps) > n_own else ""
+    out(f"capsules    {len(caps)} ({n_own} {cap_kind}{extra})")
+    for k in caps:
+        length = float(np.linalg.norm(np.subtract(k.p1, k.p0)))
+        out(f"            {k.name:<18} on joint {k.joint:>2}  radius {k.radius:.3f} m  length {length:.3f} m")
+    if task.trajectory_csv:
+        out(f"task        trajectory file {task.trajectory_csv}, {traj.n_segments + 1} rows, linear moves, "
+            f"phase {num(task.phase)} s, cycle time {traj.cycle:.2f} s")
+    else:
+        what = f"{len(task.poses)} tool poses of {task.tool_frame}" if task.poses else \
+            f"{len(task.waypoints_deg)} waypoints"
+        dwell = "per waypoint" if task.dwells else f"{num(task.dwell)} s"
+        scale = "per move" if task.speed_scales else num(task.speed_scale)
+        out(f"task        {what}, dwell {dwell}, speed scale {scale}, phase {num(task.phase)} s, "
+            f"cycle time {traj.cycle:.2f} s")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import Discriminator, Tag
+from pydantic import Discriminator, Field, Tag
 
 from cellstress.core.fields import Name, PositiveTime, Record
 from cellstress.core.records import Channel, IsoDistance
@@ -40,6 +40,10 @@ class DeviceRecord(Record):
     the episode) or ``{automatic: CLEAR_TIME}`` (the robot restarts once this device has not seen the worker for
     CLEAR_TIME seconds and no other device holds a stop)."""
 
+    stops: tuple[Annotated[str, Field(min_length=1, max_length=32)], ...] | None = Field(None, min_length=1,
+                                                                                       max_length=4)
+    """The robots its detection stops, by name (``robots[].name``); absent: every robot of the cell."""
+
     @property
     def clear_time(self) -> float:
         """The automatic restart's clear time [s]; inf for a manual restart (the stop is never released)."""
@@ -53,3 +57,15 @@ class DeviceRecord(Record):
     def warning_distance(self, stopping_time: float) -> IsoDistance | None:
         """ISO 13855 distance of the device's warning field (a channel that reduces the speed), if it has one."""
         return None
+
+
+def stops_of(device) -> tuple[str, ...] | None:
+    """The robot names a device's stop is limited to (``DeviceRecord.stops``); None: every robot (also for a
+    device kind that is not a ``DeviceRecord``)."""
+    return device.stops if isinstance(device, DeviceRecord) else None
+
+
+def stops_robot(device, robot: str) -> bool:
+    """Whether ``device``'s stop stops the robot named ``robot``."""
+    stops = stops_of(device)
+    return stops is None or robot in stops

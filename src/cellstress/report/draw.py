@@ -159,7 +159,7 @@ def swept_footprint(layout: Layout):
     return hazard_zone(layout)
 
 
-def draw_plan(ax, layout: Layout, style: PlanStyle = PlanStyle(), robot_tau: float | None = None,
+def draw_plan(ax, layout: Layout, style: PlanStyle = PlanStyle(), robot_tau: float | np.ndarray | None = None,
               zone=None, robot_when: str = "at contact") -> list:
     """Draw the cell to scale in metres; returns legend handles (one per kind of thing shown). The robot is
     drawn at path time ``robot_tau`` (labelled ``robot_when``), or at t = 0 without one."""
@@ -188,9 +188,14 @@ def draw_plan(ax, layout: Layout, style: PlanStyle = PlanStyle(), robot_tau: flo
         ax.plot(xy[:, 0], xy[:, 1], color=FENCE, lw=3.5, solid_capstyle="projecting", zorder=5)
     if spec.fences:
         handles.append(Line2D([], [], color=FENCE, lw=3.5, label=f"fence ({spec.fences[0].top:g} m)"))
-    base = spec.robot.base.xyz
-    ax.plot([base[0]], [base[1]], marker="P", ms=9, color=ROBOT, mec="white", zorder=7, ls="none")
-    handles.append(Line2D([], [], marker="P", ms=9, color=ROBOT, mec="white", ls="none", label="robot base"))
+    for rs in spec.robots:
+        base = rs.base.xyz
+        ax.plot([base[0]], [base[1]], marker="P", ms=9, color=ROBOT, mec="white", zorder=7, ls="none")
+        if len(spec.robots) > 1:
+            ax.annotate(rs.name, (base[0], base[1]), xytext=(6, 6), textcoords="offset points", fontsize=8,
+                        color=ROBOT, zorder=7)
+    handles.append(Line2D([], [], marker="P", ms=9, color=ROBOT, mec="white", ls="none",
+                          label="robot base" if len(spec.robots) == 1 else "robot bases"))
     if style.robot_now:
         tau = float(layout.params.scal[L.C_PHASE0]) if robot_tau is None else robot_tau  # the pose at t = 0
         a, b = scene.robot_capsules(layout, tau)
@@ -236,13 +241,13 @@ def draw_obstacles(ax, layout: Layout) -> list:
     for o in layout.obstacles:
         face, edge = obstacle_colors(o)
         ax.add_patch(Polygon(o.footprint(), closed=True, facecolor=face, edgecolor=edge, lw=1.0, zorder=1))
-        if not _is_table(o) and o.name != PEDESTAL:  # (the robot base marker shows the pedestal)
+        if not _is_table(o) and not _is_pedestal(layout, o):  # (the robot base marker shows the pedestal)
             cx, cy = np.mean(np.asarray(o.footprint(), float), axis=0)
             ax.annotate(f"{o.name}\n{o.height:g} m", (cx, cy), ha="center", va="center", fontsize=6,
                         color=edge, zorder=1.5, annotation_clip=True)
     if tables:
         handles.append(Patch(facecolor=TABLE, edgecolor=TABLE_EDGE, label=f"table ({tables[0].height:g} m)"))
-    if any(not _is_table(o) and o.name != PEDESTAL for o in layout.obstacles):
+    if any(not _is_table(o) and not _is_pedestal(layout, o) for o in layout.obstacles):
         handles.append(Patch(facecolor=OBSTACLE, edgecolor=OBSTACLE_EDGE, label="obstacle (name, height)"))
     return handles
 
@@ -258,3 +263,8 @@ def draw_pose_arrow(ax, x: float, y: float, heading: float, color: str, size: fl
                     alpha=alpha)
     ax.add_patch(patch)
     return patch
+
+
+def _is_pedestal(layout: Layout, o) -> bool:
+    """A robot's own pedestal (``sim.build.pedestal``: after the cell's obstacles, one per robot)."""
+    return o.name == PEDESTAL or o in layout.obstacles[len(layout.cell.spec.solid_obstacles()):]

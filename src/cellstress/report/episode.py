@@ -72,7 +72,7 @@ class EpisodeView:
                                math.radians(r.forward_flexion_deg), math.radians(r.lateral_flexion_deg))
 
     def robot(self, i: int) -> tuple[np.ndarray, np.ndarray]:
-        return scene.robot_capsules(self.layout, float(self.taus[i]))
+        return scene.robot_capsules(self.layout, self.taus[i])
 
     def reach(self, i: int, side: int, stride: int = 1, pose: scene.BodyPose | None = None) -> np.ndarray:
         nodes = self._nodes.get(stride)
@@ -116,7 +116,8 @@ def replay(sim: Simulator, actions, *, episode: int | None = None, kind: str = "
     # the actions actually played: an unsafe step ends the episode and drops the actions after it
     n_played = -(-(len(records) - 1) // sim.steps_per_action)
     acts = tuple(ACTION_NAMES[action_index(a)] for a in list(actions)[:n_played])
-    return EpisodeView(sim.layout, sim.start, acts, tuple(records), scene.path_times(trace.rows), episode, kind,
+    taus = scene.path_times(trace.rows, len(sim.layout.robots))
+    return EpisodeView(sim.layout, sim.start, acts, tuple(records), taus, episode, kind,
                        matches)
 
 

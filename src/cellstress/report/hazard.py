@@ -61,11 +61,12 @@ def layout_figure(layout: Layout, size: D.FigureSize = StillOptions().layout, ti
 def _draw_distances(ax, static: StaticCheck) -> list:
     """ISO 13855 dimension lines: green where the layout gives the required distance S, red where it does not;
     the closest undetected reach (ISO 13857) likewise."""
-    lines = [(d.where, f"{d.device}: S {d.required:.2f} m needed, {d.actual:.2f} m here", d.ok)
-             for d in static.devices if d.where is not None]
-    a = static.approach
-    if a.where is not None and math.isfinite(a.distance):
-        lines.append((a.where, f"reach around: {a.distance:.2f} m, {a.arm_allowance:.2f} m needed", a.ok))
+    lines = [(d.where, f"{d.device}{' -> ' + d.robot if d.robot else ''}: S {d.required:.2f} m needed, "
+              f"{d.actual:.2f} m here", d.ok) for d in static.devices if d.where is not None]
+    for a in (static.approach, *static.robot_approaches):  # (several robots: the reach to each one's zone)
+        if a.where is not None and math.isfinite(a.distance):
+            whose = f" to {a.robot}" if a.robot else ""
+            lines.append((a.where, f"reach around{whose}: {a.distance:.2f} m, {a.arm_allowance:.2f} m needed", a.ok))
     placed: list[tuple[float, float]] = []
     for where, text, ok in lines:
         color = OK_COLOR if ok else FAIL_COLOR
@@ -163,7 +164,7 @@ def topview_figure(view: EpisodeView, size: D.FigureSize = StillOptions().topvie
     zone = zone if zone is not None else D.swept_footprint(view.layout)
     pose = view.pose(key)
     reach = [view.reach(key, side, REACH_STRIDE_STILL, pose) for side in (0, 1)]
-    handles = D.draw_plan(ax, view.layout, robot_tau=float(view.taus[key]), zone=zone,
+    handles = D.draw_plan(ax, view.layout, robot_tau=view.taus[key], zone=zone,
                           robot_when="at contact" if view.unsafe else "at the closest call")
     _draw_episode(ax, view, pose, reach, handles, mark_size=0.16)
     spec = view.layout.cell.spec
@@ -172,7 +173,7 @@ def topview_figure(view: EpisodeView, size: D.FigureSize = StillOptions().topvie
     _legend(fig, ax, handles)
     # the enlarged view: the path, the touching reach volume and the contact, with a margin
     inset = fig.add_axes(INSET_AXES)
-    D.draw_plan(inset, view.layout, D.PlanStyle(start_size=0.12), robot_tau=float(view.taus[key]), zone=zone)
+    D.draw_plan(inset, view.layout, D.PlanStyle(start_size=0.12), robot_tau=view.taus[key], zone=zone)
     _draw_episode(inset, view, pose, reach, None, mark_size=0.08)
     recs = view.records
     hit = recs[key]

@@ -9,6 +9,7 @@ import math
 from dataclasses import dataclass
 
 from cellstress.report.episode import EpisodeView
+from cellstress.searchers.why import touched_robot
 from cellstress.sim.layout import C_PHASE0
 
 _TURNS = {"walk": "walks forward", "turn-left-45": "turns 45° left", "turn-left-90": "turns 90° left",
@@ -128,7 +129,7 @@ def account(view: EpisodeView, episodes: int | None = None) -> Account:
         phase_text = f"a stop requested by '{stop[1]}' takes effect only at t = {stop[0]:.2f} s"
     elif phase == "braking" and stop:
         phase_text = (f"the robot has been braking since t = {stop[0]:.2f} s and would stand still at "
-                      f"t = {stop[0] + view.layout.cell.spec.robot.stopping_time:.2f} s")
+                      f"t = {stop[0] + touched_robot(view.layout, hit).spec.stopping_time:.2f} s")
     else:
         phase_text = _PHASES.get(phase, phase)
     moves = ", ".join(f"{_SHORT_TURNS.get(w, w)} {_SHORT_BODIES.get(b, b)}"

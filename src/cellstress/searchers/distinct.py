@@ -61,7 +61,9 @@ def link_group(layout, link: str) -> str:
     chain by the joint a capsule rides on), so that one flaw hit by the forearm in one episode and by the
     upper arm in the next is one root cause, on any serial robot."""
     joints = {c.name: c.joint for c in layout.capsules}
-    n = max(layout.robot.n_joints, 1)
+    # (several robots: the chain of the robot that owns the link)
+    owner = next((p.model for p in layout.robots if any(c.name == link for c in p.capsules)), layout.robot)
+    n = max(owner.n_joints, 1)
     j = joints.get(link, -1) + 1  # 0: the base, n: the last joint
     third = 3 * j / (n + 1)
     return "base side" if third < 1 else "middle" if third < 2 else "wrist and tool"

@@ -136,7 +136,7 @@ class Plan:
                     break
             rows = np.concatenate(rows)
             model.learn(played, rows)
-            running = rows[rows[:, L.M_PHASE] == L.PHASE_RUNNING, L.M_D]
+            running = rows[model.owner_phase(rows) == L.PHASE_RUNNING, L.M_D]
             closest[tuple(played)] = float(running.min()) if len(running) else math.inf
             rec.finish(played, ret, risk, unsafe)  # raises Stop at the end
 
@@ -185,9 +185,13 @@ class _Model:
         n_path = int(self.offsets.max()) + self.n_steps + 1
         self.v_tol = float(sim.params.scal[L.C_VTOL])
         self.pose_cols = [L.M_X, L.M_Y, L.M_HEADING, L.M_FWD, L.M_LAT]
-        self.points: list[dict] = [{} for _ in range(n_path)]  # path step -> {cell: (point, offset)}
-        self.speed = np.full(n_path, np.nan)  # v_R on the programmed path, per path step
-        self.delays: dict[int, list[tuple[int, int]]] = {}  # device mask -> [(to braking, to standstill)]
+        # per robot (a cell of several robots: each has its own path, speed and stop)
+        self.n_robots = 1 + int(sim.params.x_scal.shape[0])
+        # path step -> {cell: (point, offset)}
+        self.points: list[list[dict]] = [[{} for _ in range(n_path)] for _ in range(self.n_robots)]
+        self.speed = [np.full(n_path, np.nan) for _ in range(self.n_robots)]  # v_R on the path, per path step
+        # device mask -> [(to braking, to standstill)]
+        self.delays: list[dict[int, list[tuple[int, int]]]] = [{} for _ in range(self.n_robots)]
         # played prefix -> (its rows' count, devices seen per row, first braking and standstill row or -1)
         self.prefixes: dict[tuple[int, ...], tuple[int, np.ndarray, int, int]] = {}
         self.feats: list[np.ndarray] = []
@@ -199,55 +203,76 @@ class _Model:
         return np.column_stack([wx * poses[:, 0], wy * poses[:, 1], wh * np.cos(poses[:, 2]),
                                 wh * np.sin(poses[:, 2]), wf * poses[:, 3], wf * poses[:, 4]])
 
+    def owner_phase(self, rows: np.ndarray) -> np.ndarray:
+        """The stop phase, in each row, of the robot that owns the row's nearest point (robot 0's: one robot)."""
+        if self.n_robots == 1:
+            return rows[:, L.M_PHASE]
+        owner = np.maximum(rows[:, L.M_ROBOT], 0).astype(np.int64)
+        cols = np.where(owner == 0, L.M_PHASE, L.M_XPHASE + owner - 1)
+        return rows[np.arange(len(rows)), cols]
+
+    def _phase(self, rows: np.ndarray, r: int) -> np.ndarray:
+        """Robot r's stop phase in each row (robot 0's is PHASE; the others' are appended)."""
+        return rows[:, L.M_PHASE] if r == 0 else rows[:, L.M_XPHASE + r - 1]
+
     def learn(self, actions: list[int], rows: np.ndarray) -> None:
         base = int(self.offsets[actions[0] % len(self.offsets)]) if self.lead else 0
         rows = rows[self.lead:]  # (a first decision's row is the initial state's)
         seen = rows[:, L.M_SEEN].astype(np.int64)
         # (not ``>=``: REDUCED, a warning field's slower running, comes after STOPPED in the phase list)
-        braking = np.flatnonzero((rows[:, L.M_PHASE] == L.PHASE_BRAKING) | (rows[:, L.M_PHASE] == L.PHASE_STOPPED))
-        stopped = np.flatnonzero(rows[:, L.M_PHASE] == L.PHASE_STOPPED)
+        phases = [self._phase(rows, r) for r in range(self.n_robots)]
+        braking = [np.flatnonzero((ph == L.PHASE_BRAKING) | (ph == L.PHASE_STOPPED)) for ph in phases]
+        stopped = [np.flatnonzero(ph == L.PHASE_STOPPED) for ph in phases]
         for p in range(1 + self.lead, len(actions) + 1):
             n = min((p - self.lead) * self.spa, len(rows))
-            b = int(braking[0]) if len(braking) and braking[0] < n else -1
-            s = int(stopped[0]) if len(stopped) and stopped[0] < n else -1
+            b = tuple(int(br[0]) if len(br) and br[0] < n else -1 for br in braking)
+            s = tuple(int(st[0]) if len(st) and st[0] < n else -1 for st in stopped)
             self.prefixes[tuple(actions[:p])] = (n, seen[:n], b, s)
         # the robot on its path: running (at full or, behind a warning field, reduced speed: taken as part of the
         # path, which is exact when the field trips at the same step in every episode) or with a stop pending,
-        # and before any braking (after a stop, an automatic restart resumes the path later than the clock)
-        phase = rows[:, L.M_PHASE]
-        upto = int(braking[0]) if len(braking) else len(rows)
-        on_path = rows[:upto][(phase[:upto] <= L.PHASE_PENDING) | (phase[:upto] == L.PHASE_REDUCED)]
-        if len(on_path):
-            pts = on_path[:, [L.M_RX, L.M_RY, L.M_RZ]]
-            reach = self.sim.worker_distances(on_path[:, self.pose_cols], pts[:, None, :])[:, 0]
-            for row, point, dist in zip(on_path, pts, reach, strict=True):
-                k = base + int(row[L.M_STEP])
-                self.speed[k] = row[L.M_V]
-                cell = tuple(np.round(point / POINT_GRID).astype(int))
-                offset = float(dist - row[L.M_D])
-                old = self.points[k].get(cell)
-                if old is None or offset < old[1]:
-                    self.points[k][cell] = (point, offset)
-        if seen.any():
-            first = int(np.argmax(seen > 0))
-            if len(stopped):
-                self.delays.setdefault(int(seen[first]), []).append((int(braking[0]) - first,
-                                                                      int(stopped[0]) - first))
+        # and before any braking (after a stop, an automatic restart resumes the path later than the clock). With
+        # several robots, each row teaches about the robot that owns its nearest point, on that robot's own clock.
+        for r in range(self.n_robots):
+            phase = phases[r]
+            upto = int(braking[r][0]) if len(braking[r]) else len(rows)
+            keep = (phase[:upto] <= L.PHASE_PENDING) | (phase[:upto] == L.PHASE_REDUCED)
+            if self.n_robots > 1:
+                keep &= rows[:upto, L.M_ROBOT] == r
+            on_path = rows[:upto][keep]
+            if len(on_path):
+                pts = on_path[:, [L.M_RX, L.M_RY, L.M_RZ]]
+                reach = self.sim.worker_distances(on_path[:, self.pose_cols], pts[:, None, :])[:, 0]
+                for row, point, dist in zip(on_path, pts, reach, strict=True):
+                    k = base + int(row[L.M_STEP])
+                    self.speed[r][k] = row[L.M_V]
+                    cell = tuple(np.round(point / POINT_GRID).astype(int))
+                    offset = float(dist - row[L.M_D])
+                    old = self.points[r][k].get(cell)
+                    if old is None or offset < old[1]:
+                        self.points[r][k][cell] = (point, offset)
+            if seen.any():
+                first = int(np.argmax(seen > 0))
+                if len(stopped[r]):
+                    self.delays[r].setdefault(int(seen[first]), []).append((int(braking[r][0]) - first,
+                                                                            int(stopped[r][0]) - first))
         self.feats.append(self._features(rows[:, self.pose_cols]))
         self.seen.append(seen)
         self._tree = self._by_step = None
 
-    def _step_points(self) -> tuple[np.ndarray, np.ndarray]:
-        """The robot points and offsets of every step, padded with NaN points: (steps + 1, m, 3), (steps + 1, m)."""
+    def _step_points(self, r: int) -> tuple[np.ndarray, np.ndarray]:
+        """Robot r's points and offsets of every step, padded with NaN points: (steps + 1, m, 3), (steps + 1, m)."""
         if self._by_step is None:
-            m = max(1, max(len(p) for p in self.points))
-            pts = np.full((len(self.points), m, 3), np.nan)
-            off = np.zeros((len(self.points), m))
-            for k, found in enumerate(self.points):
+            self._by_step = [None] * self.n_robots
+        if self._by_step[r] is None:
+            points = self.points[r]
+            m = max(1, max(len(p) for p in points))
+            pts = np.full((len(points), m, 3), np.nan)
+            off = np.zeros((len(points), m))
+            for k, found in enumerate(points):
                 for i, (point, offset) in enumerate(found.values()):
                     pts[k, i], off[k, i] = point, offset
-            self._by_step = pts, off
-        return self._by_step
+            self._by_step[r] = pts, off
+        return self._by_step[r]
 
     def predict(self, seqs: np.ndarray) -> np.ndarray:
         """The predicted clearance of each sequence (module docstring, 3.)."""
@@ -260,41 +285,42 @@ class _Model:
         poses = self.sim.worker_paths(seqs[:, self.lead:]).reshape(-1, 5)
         seen = seen_at[tree.query(self._features(poses))[1]].reshape(n, steps)
         known = np.zeros(n, dtype=np.int64)
-        played_brake = np.full(n, -1)
-        played_stop = np.full(n, -1)
+        played_brake = np.full((self.n_robots, n), -1)
+        played_stop = np.full((self.n_robots, n), -1)
         for i, seq in enumerate(map(tuple, seqs.tolist())):
             p = len(seq) - 1
             while p > 0 and seq[:p] not in self.prefixes:
                 p -= 1
             if p:
-                known[i], seen_k, played_brake[i], played_stop[i] = self.prefixes[seq[:p]]
+                known[i], seen_k, played_brake[:, i], played_stop[:, i] = self.prefixes[seq[:p]]
                 seen[i, : known[i]] = seen_k
-        # the stop after the first detection, by the delays learned for the devices that saw the worker first
-        # (unknown devices: the robot is taken to keep moving); where the played prefix shows it, as it happened
-        brake = np.full(n, steps)
-        stop = np.full(n, steps)
         detected = seen.any(axis=1)
         first = (seen > 0).argmax(axis=1)
         mask = seen[np.arange(n), first]
-        for m in np.unique(mask[detected]):
-            delays = self.delays.get(int(m))
-            if delays:
-                sel = detected & (mask == m)
-                brake[sel] = first[sel] + int(np.median([b for b, _ in delays]))
-                stop[sel] = first[sel] + int(np.median([s for _, s in delays]))
-        brake = np.where(played_brake >= 0, played_brake, brake)
-        stop = np.where(played_stop >= 0, played_stop, stop)
-        # the robot step each candidate step meets (0-based step k -> row step k + 1; braking: its first step)
         k = np.arange(steps)[None, :]
-        robot_step = np.minimum(k, brake[:, None]) + 1
-        if self.lead:
-            robot_step = robot_step + self.offsets[seqs[:, 0] % len(self.offsets)][:, None]
-        use = (k >= known[:, None]) & (k < stop[:, None]) & (np.nan_to_num(self.speed[robot_step]) > self.v_tol)
-        pts, off = self._step_points()
-        which = np.flatnonzero(use.ravel())
         dist = np.full(n * steps, np.inf)
-        if len(which):
-            rs = robot_step.ravel()[which]
-            d = self.sim.worker_distances(poses[which], pts[rs]) - off[rs]
-            dist[which] = d.min(axis=1)
+        for r in range(self.n_robots):
+            # the stop after the first detection, by the delays learned for the devices that saw the worker first
+            # (unknown devices: the robot is taken to keep moving); where the played prefix shows it, as it happened
+            brake = np.full(n, steps)
+            stop = np.full(n, steps)
+            for m in np.unique(mask[detected]):
+                delays = self.delays[r].get(int(m))
+                if delays:
+                    sel = detected & (mask == m)
+                    brake[sel] = first[sel] + int(np.median([b for b, _ in delays]))
+                    stop[sel] = first[sel] + int(np.median([s for _, s in delays]))
+            brake = np.where(played_brake[r] >= 0, played_brake[r], brake)
+            stop = np.where(played_stop[r] >= 0, played_stop[r], stop)
+            # the robot step each candidate step meets (0-based step k -> row step k + 1; braking: its first step)
+            robot_step = np.minimum(k, brake[:, None]) + 1
+            if self.lead:
+                robot_step = robot_step + self.offsets[seqs[:, 0] % len(self.offsets)][:, None]
+            use = (k >= known[:, None]) & (k < stop[:, None]) & (np.nan_to_num(self.speed[r][robot_step]) > self.v_tol)
+            pts, off = self._step_points(r)
+            which = np.flatnonzero(use.ravel())
+            if len(which):
+                rs = robot_step.ravel()[which]
+                d = self.sim.worker_distances(poses[which], pts[rs]) - off[rs]
+                dist[which] = np.minimum(dist[which], d.min(axis=1))
         return dist.reshape(n, steps).min(axis=1)

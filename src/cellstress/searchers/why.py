@@ -8,6 +8,7 @@ static check.
 
 from __future__ import annotations
 
+from cellstress.devices.base import stops_robot
 from cellstress.searchers.result import DeviceTiming, Why
 from cellstress.sim import layout as L
 
@@ -87,10 +88,32 @@ def _door_words(name: str, opening: float, locked: bool, pushed: float, first_st
     return f"{name} opened at {pushed:.2f} s without guard locking and let the worker through from {through:.2f} s{gap}"
 
 
+def touched_robot(layout, record):
+    """The robot (a ``sim.build.RobotPart``) whose capsule a record's ``robot_link`` names: in a cell of several
+    robots the capsules are named ``ROBOT:link``; robot 0 for a one-robot cell or a record without a link."""
+    parts = layout.robots
+    link = record.robot_link
+    if len(parts) < 2 or not link or ":" not in link:
+        return parts[0] if parts else None
+    name = link.split(":", 1)[0]
+    return next((p for p in parts if p.name == name), parts[0])
+
+
 def explain(layout, records, unsafe_row: int) -> Why:
-    """The ``Why`` of the hazard at ``records[unsafe_row]`` (``records``: the episode's ``StepRecord`` rows)."""
+    """The ``Why`` of the hazard at ``records[unsafe_row]`` (``records``: the episode's ``StepRecord`` rows). In a
+    cell of several robots only the devices that stop the touched robot count, with its stopping time."""
     spec = layout.cell.spec
     words = safeguard_words(layout, records, unsafe_row)
+    robot = touched_robot(layout, records[unsafe_row])
+    stopping_time = spec.robot.stopping_time if robot is None else robot.spec.stopping_time
+    if len(layout.robots) > 1:
+        others = [d.name for d in spec.devices if not stops_robot(d, robot.name)
+                  and any(d.name in r.devices for r in records[: unsafe_row + 1])]
+        if others:
+            note = f"{', '.join(others)} saw the worker but {'does' if len(others) == 1 else 'do'} not stop " \
+                   f"robot {robot.name}"
+            words = note if words is None else f"{note}; {words}"
+    stopping = {d.name for d in spec.devices if len(layout.robots) < 2 or stops_robot(d, robot.name)}
     response = {d.name: float(d.response_time) for d in spec.devices}
     saw: dict[str, float] = {}
     for r in records[: unsafe_row + 1]:
@@ -100,12 +123,12 @@ def explain(layout, records, unsafe_row: int) -> Why:
         device=d.name, saw_at_s=saw.get(d.name),
         stop_at_s=None if d.name not in saw else _r(saw[d.name] + response[d.name])) for d in spec.devices)
     contact = records[unsafe_row].t
-    stops = [t for t in timings if t.stop_at_s is not None]
+    stops = [t for t in timings if t.stop_at_s is not None and t.device in stopping]
     if not stops:
         return Why.model_construct(detected=False, devices=timings, stopped_by=None, braking_from_s=None,
                                    standstill_at_s=None, contact_at_s=contact, late_by_s=None, safeguards=words)
     first = min(stops, key=lambda t: t.stop_at_s)  # (min keeps the cell's order among equal times)
-    standstill = _r(first.stop_at_s + float(spec.robot.stopping_time))
+    standstill = _r(first.stop_at_s + float(stopping_time))
     return Why.model_construct(detected=True, devices=timings, stopped_by=first.device,
                                braking_from_s=first.stop_at_s, standstill_at_s=standstill, contact_at_s=contact,
                                late_by_s=_r(standstill - contact), safeguards=words)
@@ -115,6 +138,10 @@ def why_words(why: Why) -> str:
     """The timeline in one sentence."""
     if not why.detected:
         extra = "" if why.safeguards is None else f"; {why.safeguards}"
+        if why.safeguards is not None and "not stop robot" in why.safeguards:
+            # several robots: seen, but by no device that stops the robot touched
+            return f"no device that stops the touched robot saw the worker before the contact at " \
+                   f"{why.contact_at_s:.2f} s{extra}"
         return f"undetected: no device saw the worker before the contact at {why.contact_at_s:.2f} s{extra}"
     first = next(t for t in why.devices if t.device == why.stopped_by)
     late = why.late_by_s

@@ -9,9 +9,10 @@ import numpy as np
 
 from cellstress.cell.load import Cell
 from cellstress.cell.program import held_joints, robot_program
-from cellstress.cell.schema import ObstacleSpec
+from cellstress.cell.schema import ObstacleSpec, RobotSpec
 from cellstress.core.protocols import Channels, TimedPanels
 from cellstress.core.records import MAX_DOORS, Channel, DoorLeaf, ScanPlane, VerticalField
+from cellstress.devices.base import stops_of
 from cellstress.human.actions import action_table
 from cellstress.human.body import BodyDimensions
 from cellstress.human.reach import ReachField, reach_field
@@ -102,7 +103,8 @@ class Layout:
     device_names: tuple[str, ...]
     params: K.SimParams
     joints: JointMap  # the joints the program drives; the others are held or mimic ones
-    obstacles: tuple[ObstacleSpec, ...] = ()  # the table's polygons, the cell's obstacles, the robot's pedestal
+    obstacles: tuple[ObstacleSpec, ...] = ()  # the table's polygons, the cell's obstacles, the robots' pedestals
+    robots: tuple[RobotPart, ...] = ()  # every robot, robot 0 (robot, capsules' first, trajectory, joints) first
 
     @property
     def static_fences(self) -> bool:
@@ -116,24 +118,28 @@ class Layout:
     def stops_latch(self) -> bool:
         """True when every stop holds for the rest of the episode and no device changes the robot's speed
         otherwise (every device restarts manually, none has a warning field): once a latched stop has taken
-        full effect the robot is at rest for good. False with an automatic restart or a warning field."""
-        return bool(np.all(self.params.dev_clear == np.inf) and np.all(self.params.dev_speed == 0.0))
+        full effect the robot is at rest for good. False with an automatic restart or a warning field, and in a
+        cell of several robots (the verifier's bounds assume one: docs/verify.md)."""
+        return bool(np.all(self.params.dev_clear == np.inf) and np.all(self.params.dev_speed == 0.0)
+                    and self.params.x_scal.shape[0] == 0)
 
 
 PEDESTAL = "robot-pedestal"
 
 
-def pedestal(spec, robot: RobotModel) -> ObstacleSpec | None:
-    """The robot's base as an obstacle: its footprint from the floor to the top of its fixed links."""
-    if spec.robot.pedestal == "none":
+def pedestal(rs: RobotSpec, robot: RobotModel, several: bool = False) -> ObstacleSpec | None:
+    """The robot's base as an obstacle: its footprint from the floor to the top of its fixed links (named
+    ``robot-pedestal``, or ``NAME-pedestal`` in a cell of several robots)."""
+    if rs.pedestal == "none":
         return None
     hull, top = base_footprint(robot)
-    m = base_matrix(spec.robot.base.xyz, spec.robot.base.yaw_deg)
+    m = base_matrix(rs.base.xyz, rs.base.yaw_deg)
     world = hull @ m[:2, :2].T + m[:2, 3]
     height = float(m[2, 3]) + top
     if height <= 0.0:
         return None
-    return ObstacleSpec.model_construct(name=PEDESTAL, polygon=tuple(map(tuple, world.tolist())), box=None,
+    name = f"{rs.name}-pedestal" if several else PEDESTAL
+    return ObstacleSpec.model_construct(name=name, polygon=tuple(map(tuple, world.tolist())), box=None,
                                         height=height)
 
 
@@ -147,21 +153,34 @@ def obstacle_arrays(obstacles) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 
-def build_layout(cell: Cell) -> Layout:
-    spec = cell.spec
-    robot = load_robot(resolve_urdf(spec.robot.urdf, cell.files_dir))
-    if spec.robot.capsules == "auto":
+@dataclass(frozen=True)
+class RobotPart:
+    """One robot of a cell as the simulator holds it: ``Layout.robots``, robot 0 first."""
+
+    name: str
+    spec: RobotSpec
+    model: RobotModel
+    capsules: tuple[Capsule, ...]  # named "NAME:link" in a cell of several robots
+    trajectory: Trajectory
+    joints: JointMap
+    first_capsule: int  # its capsules' first index in Layout.capsules (and the kernel's capsule arrays)
+
+
+def _robot_part(cell: Cell, rs: RobotSpec, first: int, prefix: str) -> RobotPart:
+    robot = load_robot(resolve_urdf(rs.urdf, cell.files_dir))
+    if rs.capsules == "auto":
         caps = list(fitted_capsules(robot))
     else:
-        caps = [declared_capsule(robot, c.link, c.link, c.p0, c.p1, c.radius) for c in spec.robot.capsules]
-    for i, c in enumerate(spec.robot.extra_capsules):
+        caps = [declared_capsule(robot, c.link, c.link, c.p0, c.p1, c.radius) for c in rs.capsules]
+    for i, c in enumerate(rs.extra_capsules):
         caps.append(declared_capsule(robot, f"{c.link}#extra{i}", c.link, c.p0, c.p1, c.radius))
-    task = spec.robot.task
-    traj = robot_program(cell.source, robot, spec.robot, cell.files_dir)
-    anth = spec.human.anthropometry
-    body = BodyDimensions(anth.height, anth.upper_arm, anth.forearm, anth.hand, spec.human.walking_speed)
-    reach = reach_field(anth.upper_arm, anth.forearm, anth.hand)
+    if prefix:
+        caps = [dataclasses.replace(c, name=prefix + c.name) for c in caps]
+    traj = robot_program(cell.source, robot, rs, cell.files_dir)
+    return RobotPart(rs.name, rs, robot, tuple(caps), traj, held_joints(cell.source, robot, rs), first)
 
+
+def _ancestors(robot: RobotModel) -> np.ndarray:
     nj = robot.n_joints
     anc = np.zeros((nj, nj))
     for i in range(nj):
@@ -169,11 +188,28 @@ def build_layout(cell: Cell) -> Layout:
         while j >= 0:
             anc[i, j] = 1.0
             j = int(robot.parents[j])
+    return anc
+
+
+def build_layout(cell: Cell) -> Layout:
+    spec = cell.spec
+    parts: list[RobotPart] = []
+    several = len(spec.robots) > 1
+    for rs in spec.robots:
+        first = sum(len(p.capsules) for p in parts)
+        parts.append(_robot_part(cell, rs, first, f"{rs.name}:" if several else ""))
+    part0 = parts[0]
+    robot, traj, task = part0.model, part0.trajectory, spec.robot.task
+    caps = [c for p in parts for c in p.capsules]
+    anth = spec.human.anthropometry
+    body = BodyDimensions(anth.height, anth.upper_arm, anth.forearm, anth.hand, spec.human.walking_speed)
+    reach = reach_field(anth.upper_arm, anth.forearm, anth.hand)
 
     fences = [(a[0], a[1], b[0], b[1], f.bottom, f.top)
               for f in spec.fences for a, b in zip(f.points, f.points[1:], strict=False)]
-    ped = pedestal(spec, robot)
-    obstacles = spec.solid_obstacles() + (() if ped is None else (ped,))
+    peds = tuple(p for p in (pedestal(rs, part.model, several) for rs, part in zip(spec.robots, parts, strict=True))
+                 if p is not None)
+    obstacles = spec.solid_obstacles() + peds
     obs_verts, obs_poly, obs_box = obstacle_arrays(obstacles)
 
     dev = device_arrays(spec.devices)
@@ -211,16 +247,15 @@ def build_layout(cell: Cell) -> Layout:
         parents=robot.parents.astype(np.int64),
         placements=np.ascontiguousarray(robot.placements),
         axes=np.ascontiguousarray(robot.axes),
-        jtype=np.asarray([L.JOINT_PRISMATIC if k == PRISMATIC else L.JOINT_REVOLUTE for k in robot.kinds],
-                         dtype=np.int64),
-        anc=anc,
+        jtype=_joint_kinds(robot),
+        anc=_ancestors(robot),
         wp=np.ascontiguousarray(traj.waypoints),
         seg_start=traj.starts.astype(float),
         seg_move=traj.move_times.astype(float),
         seg_dwell=traj.dwells.astype(float),
-        cap_joint=np.asarray([c.joint for c in caps], dtype=np.int64),
-        cap_a=np.asarray([c.p0 for c in caps], dtype=float).reshape(-1, 3),
-        cap_b=np.asarray([c.p1 for c in caps], dtype=float).reshape(-1, 3),
+        cap_joint=np.asarray([c.joint for c in part0.capsules], dtype=np.int64),
+        cap_a=np.asarray([c.p0 for c in part0.capsules], dtype=float).reshape(-1, 3),
+        cap_b=np.asarray([c.p1 for c in part0.capsules], dtype=float).reshape(-1, 3),
         cap_r=np.asarray([c.radius for c in caps], dtype=float),
         reach=np.ascontiguousarray(reach.values),
         fences=np.asarray(fences, dtype=float).reshape(-1, 6),
@@ -246,20 +281,87 @@ def build_layout(cell: Cell) -> Layout:
         pre_rb=np.zeros((0, len(caps), 3)),
         pre_v=np.zeros(0),
         pre_tau=np.zeros(0),
+        cap_robot=np.asarray([r for r, p in enumerate(parts) for _ in p.capsules], dtype=np.int64),
+        dev_robots=_device_robots(spec),
+        **_other_robot_arrays(spec, parts, scal),
+        pre_xv=np.zeros((0, len(parts) - 1)),
+        pre_xtau=np.zeros((0, len(parts) - 1)),
     )
     params = _with_robot_table(params, spec)
-    joints = held_joints(cell.source, robot, spec.robot)
-    return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params, joints, obstacles)
+    return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params, part0.joints, obstacles,
+                  tuple(parts))
+
+
+def _joint_kinds(robot: RobotModel) -> np.ndarray:
+    return np.asarray([L.JOINT_PRISMATIC if k == PRISMATIC else L.JOINT_REVOLUTE for k in robot.kinds], dtype=np.int64)
+
+
+def _device_robots(spec) -> np.ndarray:
+    """Per kernel channel (a device's channels in order), the bit mask of the robots its stop stops."""
+    names = [r.name for r in spec.robots]
+    masks = []
+    for d in spec.devices:
+        stops = names if stops_of(d) is None else stops_of(d)
+        mask = sum(1 << names.index(n) for n in stops)
+        n_chan = len(d.channels()) if isinstance(d, Channels) else len(tuple(d.primitives()))
+        masks.extend([mask] * n_chan)
+    return np.asarray(masks, dtype=np.int64)
+
+
+def _other_robot_arrays(spec, parts: list[RobotPart], scal: np.ndarray) -> dict[str, np.ndarray]:
+    """The x_ fields of SimParams: robots 1.., each padded to the largest joint, waypoint and capsule counts."""
+    others = parts[1:]
+    nx = len(others)
+    njx = max((p.model.n_joints for p in others), default=0)
+    nwx = max((len(p.trajectory.starts) + 1 for p in others), default=0)  # +1: the wrap-around row
+    ncx = max((len(p.capsules) for p in others), default=0)
+    out = {
+        "x_scal": np.zeros((nx, L.N_SCAL)), "x_base": np.zeros((nx, 4, 4)),
+        "x_parents": np.full((nx, njx), -1, dtype=np.int64), "x_placements": np.tile(np.eye(4), (nx, njx, 1, 1)),
+        "x_axes": np.tile(np.array([0.0, 0.0, 1.0]), (nx, njx, 1)),
+        "x_jtype": np.full((nx, njx), L.JOINT_REVOLUTE, dtype=np.int64), "x_anc": np.zeros((nx, njx, njx)),
+        "x_wp": np.zeros((nx, nwx, njx)), "x_seg_start": np.full((nx, nwx), np.inf),
+        "x_seg_move": np.ones((nx, nwx)), "x_seg_dwell": np.zeros((nx, nwx)),
+        "x_cap_joint": np.full((nx, ncx), -1, dtype=np.int64), "x_cap_a": np.zeros((nx, ncx, 3)),
+        "x_cap_b": np.zeros((nx, ncx, 3)), "x_cap0": np.zeros(nx, dtype=np.int64),
+        "x_ncap": np.zeros(nx, dtype=np.int64),
+    }
+    for r, (rs, p) in enumerate(zip(spec.robots[1:], others, strict=True)):
+        m, tr, nj, nw, nc = p.model, p.trajectory, p.model.n_joints, len(p.trajectory.starts), len(p.capsules)
+        out["x_scal"][r] = scal
+        out["x_scal"][r, L.C_STOP_TIME] = rs.stopping_time
+        out["x_scal"][r, L.C_PHASE0] = rs.task.phase
+        out["x_scal"][r, L.C_CYCLE] = tr.cycle
+        out["x_scal"][r, L.C_LINEAR] = 1.0 if tr.linear else 0.0
+        out["x_base"][r] = base_matrix(rs.base.xyz, rs.base.yaw_deg)
+        out["x_parents"][r, :nj] = m.parents
+        out["x_placements"][r, :nj] = m.placements
+        out["x_axes"][r, :nj] = m.axes
+        out["x_jtype"][r, :nj] = _joint_kinds(m)
+        out["x_anc"][r, :nj, :nj] = _ancestors(m)
+        # the last segment moves to the row after it: the first waypoint again (the padding never starts)
+        out["x_wp"][r, :nw, :nj] = tr.waypoints
+        out["x_wp"][r, nw:, :nj] = tr.waypoints[0]
+        out["x_seg_start"][r, :nw] = tr.starts
+        out["x_seg_move"][r, :nw] = tr.move_times
+        out["x_seg_dwell"][r, :nw] = tr.dwells
+        out["x_cap_joint"][r, :nc] = [c.joint for c in p.capsules]
+        out["x_cap_a"][r, :nc] = [c.p0 for c in p.capsules]
+        out["x_cap_b"][r, :nc] = [c.p1 for c in p.capsules]
+        out["x_cap0"][r], out["x_ncap"][r] = p.first_capsule, nc
+    return out
 
 
 def _with_robot_table(params: K.SimParams, spec) -> K.SimParams:
     """``params`` with the robot before any stop, for every step of an episode (and one spare action)."""
     n_pre = 1 + spec.simulation.steps_per_action * (spec.simulation.actions_per_episode + 1)
-    nc = params.cap_r.shape[0]
+    nc, nx = params.cap_r.shape[0], params.x_scal.shape[0]
     pre_ra, pre_rb = np.zeros((n_pre, nc, 3)), np.zeros((n_pre, nc, 3))
     pre_v, pre_tau = np.zeros(n_pre), np.zeros(n_pre)
-    K.robot_table(params, n_pre, pre_ra, pre_rb, pre_v, pre_tau)
-    return params._replace(pre_ra=pre_ra, pre_rb=pre_rb, pre_v=pre_v, pre_tau=pre_tau)
+    pre_xv, pre_xtau = np.zeros((n_pre, nx)), np.zeros((n_pre, nx))
+    K.robot_table(params, n_pre, pre_ra, pre_rb, pre_v, pre_tau, pre_xv, pre_xtau)
+    return params._replace(pre_ra=pre_ra, pre_rb=pre_rb, pre_v=pre_v, pre_tau=pre_tau, pre_xv=pre_xv,
+                           pre_xtau=pre_xtau)
 
 
 def with_phase(layout: Layout, phase: float) -> Layout:
@@ -269,8 +371,12 @@ def with_phase(layout: Layout, phase: float) -> Layout:
         return layout
     scal = layout.params.scal.copy()
     scal[L.C_PHASE0] = float(phase)
-    nc = layout.params.cap_r.shape[0]
-    bare = layout.params._replace(scal=scal, pre_ra=np.zeros((0, nc, 3)), pre_rb=np.zeros((0, nc, 3)),
-                                  pre_v=np.zeros(0), pre_tau=np.zeros(0))  # as build_layout computes it
+    # the other robots' clocks move with robot 0's: the worker arrives at another moment of the whole cell
+    x_scal = layout.params.x_scal.copy()
+    x_scal[:, L.C_PHASE0] += float(phase) - float(layout.params.scal[L.C_PHASE0])
+    nc, nx = layout.params.cap_r.shape[0], layout.params.x_scal.shape[0]
+    bare = layout.params._replace(scal=scal, x_scal=x_scal, pre_ra=np.zeros((0, nc, 3)), pre_rb=np.zeros((0, nc, 3)),
+                                  pre_v=np.zeros(0), pre_tau=np.zeros(0), pre_xv=np.zeros((0, nx)),
+                                  pre_xtau=np.zeros((0, nx)))  # as build_layout computes it
     params = _with_robot_table(bare, layout.cell.spec)
     return dataclasses.replace(layout, params=params)

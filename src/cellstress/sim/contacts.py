@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 
+from cellstress.core.errors import CellstressError
 from cellstress.core.records import Contact
 from cellstress.human.body import BODY_PARTS
 from cellstress.human.regions import body_region
@@ -27,6 +28,10 @@ class ContactModel:
     """Contacts of one simulator layout (pinocchio model and data made once, like the simulator's work arrays)."""
 
     def __init__(self, layout: Layout):
+        if len(layout.robots) > 1:  # (the dynamics below are robot 0's; a contact may be with another robot)
+            raise CellstressError(f"{layout.cell.source}: criterion {layout.cell.spec.criterion.type!r} judges each "
+                                  "contact with the robot's dynamics, which is not implemented yet for a cell of "
+                                  "several robots; use a criterion with a kernel test (contact-while-moving)")
         self.layout = layout
         self.model = load_pinocchio(layout.robot.urdf)
         self.data = self.model.createData()

@@ -67,16 +67,22 @@ STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
     *((f"DOOR{i}_OPEN", f"guard door {i}: time it started to open [s] (with guard locking: once the robot was "
                         "at rest); passable from this time plus its opening time; inf: closed")
       for i in range(MAX_DOORS)),
+    # several robots: robot 0's stop is TSTOP above; robots 1..3 latch their own (appended: nothing above moves)
+    ("XTSTOP1", "time robot 1's latched stop takes effect [s]; inf: none latched (or no such robot)"),
+    ("XTSTOP2", "the same for robot 2"),
+    ("XTSTOP3", "the same for robot 3"),
 ))
 (S_K, S_X, S_Y, S_HEADING, S_FWD, S_LAT, S_TSTOP, S_TRIG_DEV, S_TRIG_T, S_UNSAFE, S_ACTIONS, S_LIVE, S_A_T, S_A_TAU,
  S_A_SIG, S_A_TGT, S_TSLOW, S_SLOW, S_STOP_SEEN, S_STOP_CLEAR, S_SLOW_SEEN, S_SLOW_CLEAR, S_RESTARTS,
  S_DOOR0_REQ, S_DOOR1_REQ, S_DOOR2_REQ, S_DOOR3_REQ, S_DOOR0_OPEN, S_DOOR1_OPEN, S_DOOR2_OPEN,
- S_DOOR3_OPEN) = STATE.indices(
+ S_DOOR3_OPEN, S_XTSTOP1, S_XTSTOP2, S_XTSTOP3) = STATE.indices(
     "K", "X", "Y", "HEADING", "FWD", "LAT", "TSTOP", "TRIG_DEV", "TRIG_T", "UNSAFE", "ACTIONS", "LIVE", "A_T", "A_TAU",
     "A_SIG", "A_TGT", "TSLOW", "SLOW", "STOP_SEEN", "STOP_CLEAR", "SLOW_SEEN", "SLOW_CLEAR", "RESTARTS",
-    *_DOOR_SLOTS)
+    *_DOOR_SLOTS, "XTSTOP1", "XTSTOP2", "XTSTOP3")
 S_DOOR_REQ, S_DOOR_OPEN = S_DOOR0_REQ, S_DOOR0_OPEN  # door i's slots: these + i (the kernels index by door)
 NS = STATE.size
+S_XTSTOP = S_XTSTOP1  # robot r >= 1's stop is S_XTSTOP + r - 1 (the kernels loop over them)
+MAX_ROBOTS = 4  # robot r >= 1 keeps its stop in S_XTSTOP + r - 1 and its path in the row's XTAU and XPHASE slots
 
 ROW = VectorSpec("metric row (one per time step; row 0 of an episode is its start)", (
     ("T", "time [s]"),
@@ -101,12 +107,21 @@ ROW = VectorSpec("metric row (one per time step; row 0 of an episode is its star
     ("TAU", "robot's path time [s]"),
     ("ACTION", "action played; -1 in an episode's first row"),
     ("STEP", "time step k"),
+    # several robots (appended): V above is the speed of the robot that owns LINK; TAU and PHASE are robot 0's
+    ("ROBOT", "robot owning the capsule LINK (0 in a one-robot cell); -1: none"),
+    ("XTAU1", "robot 1's path time [s]; -1: no such robot"),
+    ("XTAU2", "robot 2's path time [s]"),
+    ("XTAU3", "robot 3's path time [s]"),
+    ("XPHASE1", "robot 1's stop phase (PHASE); -1: no such robot"),
+    ("XPHASE2", "robot 2's stop phase"),
+    ("XPHASE3", "robot 3's stop phase"),
 ))
 (M_T, M_X, M_Y, M_HEADING, M_FWD, M_LAT, M_D, M_V, M_SEEN, M_PHASE, M_LINK, M_PART, M_RX, M_RY, M_RZ, M_HX, M_HY, M_HZ,
- M_UNSAFE, M_TAU, M_ACTION, M_STEP) = ROW.indices(
+ M_UNSAFE, M_TAU, M_ACTION, M_STEP, M_ROBOT, M_XTAU1, M_XTAU2, M_XTAU3, M_XPHASE1, M_XPHASE2, M_XPHASE3) = ROW.indices(
     "T", "X", "Y", "HEADING", "FWD", "LAT", "D", "V", "SEEN", "PHASE", "LINK", "PART", "RX", "RY", "RZ", "HX", "HY",
-    "HZ", "UNSAFE", "TAU", "ACTION", "STEP")
+    "HZ", "UNSAFE", "TAU", "ACTION", "STEP", "ROBOT", "XTAU1", "XTAU2", "XTAU3", "XPHASE1", "XPHASE2", "XPHASE3")
 NM = ROW.size
+M_XTAU, M_XPHASE = M_XTAU1, M_XPHASE1  # robot r >= 1's path time and stop phase: + r - 1
 
 PHASE = VectorSpec("robot stop phase (values of the row's PHASE; records.STOP_PHASES names them in files)", (
     ("RUNNING", "no stop latched"),

@@ -24,19 +24,32 @@ def body_pose(layout: Layout, x: float, y: float, heading: float, forward: float
     return BodyPose(W.ha.copy(), W.hb.copy(), W.hr.copy(), W.sh.copy(), W.tr.copy())
 
 
-def robot_capsules(layout: Layout, tau: float) -> tuple[np.ndarray, np.ndarray]:
+def robot_capsules(layout: Layout, tau) -> tuple[np.ndarray, np.ndarray]:
     """Robot capsule axes (a, b), each (n_capsules, 3), at path time ``tau``; radii are ``layout.params.cap_r``.
+    In a cell of several robots ``tau`` may hold each robot's path time (a row of ``path_times``); a single
+    value poses the others at the same time since the episode began, unstopped.
 
     The pose depends on the path time only (a stop slows the path time down, it does not change the path), so
-    the pose is ``kernels.robot_live`` at t = tau - phase with no stop."""
+    the pose is ``kernels.robot_live`` at t = tau - phase with no stop (``kernels.other_robots`` for the
+    others, with their phase set to their path time at step 0)."""
     P = layout.params
+    taus = np.atleast_1d(np.asarray(tau, dtype=float))
     W = K.make_work(P)
-    K.robot_live(P, float(tau) - float(P.scal[L.C_PHASE0]), np.inf, W)
+    K.robot_live(P, float(taus[0]) - float(P.scal[L.C_PHASE0]), np.inf, W)
+    nx = P.x_scal.shape[0]
+    if nx:
+        x_scal = P.x_scal.copy()
+        x_scal[:, L.C_PHASE0] = taus[1:] if len(taus) > 1 else x_scal[:, L.C_PHASE0] + taus[0] - P.scal[L.C_PHASE0]
+        state = np.full(L.NS, np.inf)
+        K.other_robots(P._replace(x_scal=x_scal, pre_xv=np.zeros((0, nx))), np.int64(0), state, W)
     return W.ra.copy(), W.rb.copy()
 
 
-def path_times(rows: np.ndarray) -> np.ndarray:
-    """The robot's path time at every row of ``Trace.rows``."""
+def path_times(rows: np.ndarray, n_robots: int = 1) -> np.ndarray:
+    """The robot's path time at every row of ``Trace.rows``; with ``n_robots`` > 1, (rows, robots): each
+    robot's."""
+    if n_robots > 1:
+        return np.asarray(rows[:, [L.M_TAU, *range(L.M_XTAU, L.M_XTAU + n_robots - 1)]], dtype=float)
     return np.asarray(rows[:, L.M_TAU], dtype=float)
 
 

@@ -72,7 +72,8 @@ def step_record(row: np.ndarray, layout: Layout) -> StepRecord:
         d_HR=float(row[L.M_D]),
         v_R=float(row[L.M_V]),
         devices=tuple(n for i, n in enumerate(layout.device_names) if seen >> i & 1),
-        stop_phase=STOP_PHASES[int(row[L.M_PHASE])],
+        stop_phase=STOP_PHASES[int(row[L.M_PHASE] if row[L.M_ROBOT] < 1
+                                   else row[L.M_XPHASE + int(row[L.M_ROBOT]) - 1])],  # the touched robot's
         robot_link=layout.capsules[link].name if link >= 0 else None,
         body_part=BODY_PARTS[part] if part >= 0 else None,
         robot_point=tuple(float(v) for v in row[L.M_RX:L.M_RZ + 1]),

@@ -10,8 +10,9 @@ that falls on a merged state is the one whose prefix is the smallest.
 **Merging.** Two states merge when their future is the same: the same time step and actions played (true of a
 whole layer), positions equal to within ``QUANT_XY`` (1 um), heading (modulo a full turn), forward and lateral
 flexion equal to within ``QUANT_ANGLE`` (1e-9 rad), the latched stop time ``TSTOP`` bit for bit and the same
-triggering device, and the guard doors' push and opening times bit for bit. The rest of the state does not
-reach the future: the first detection time ``TRIG_T`` is
+triggering device, the guard doors' push and opening times and, in a cell of several robots, each
+other robot's latched stop ``XTSTOP``, bit for bit. The rest of the state does not reach the future:
+the first detection time ``TRIG_T`` is
 written by ``sense_and_measure`` and read by nothing; ``TRIG_DEV`` is only compared with -1 to decide whether
 to write ``TRIG_T``; neither enters the worker's motion, the robot (``robot_at`` reads the step and ``TSTOP``)
 or the unsafe test. ``TRIG_DEV`` is kept in the key all the same, because it names the device of a hazard's
@@ -82,8 +83,8 @@ class TreeOutcome:
 
 def merge_keys(states: np.ndarray) -> np.ndarray:
     """One fixed-size byte key per state (rows of ``states``): equal keys, equal futures (see the module)."""
-    nd = 2 * L.MAX_DOORS
-    key = np.empty((len(states), 6 + nd), dtype=np.int64)
+    nd, nx = 2 * L.MAX_DOORS, L.MAX_ROBOTS - 1
+    key = np.empty((len(states), 6 + nd + nx), dtype=np.int64)
     key[:, 0] = np.rint(states[:, L.S_X] / QUANT_XY)
     key[:, 1] = np.rint(states[:, L.S_Y] / QUANT_XY)
     key[:, 2] = np.rint(np.mod(states[:, L.S_HEADING], TWO_PI) / QUANT_ANGLE)
@@ -92,7 +93,9 @@ def merge_keys(states: np.ndarray) -> np.ndarray:
     key[:, 5] = states[:, L.S_TSTOP].view(np.int64) * 8 + (states[:, L.S_TRIG_DEV].astype(np.int64) + 1)
     # the guard doors' push and opening times, bit for bit: they decide where the worker can go (inf in a cell
     # without doors, so its keys only gain equal bytes at the end and keep their order)
-    key[:, 6:] = np.ascontiguousarray(states[:, L.S_DOOR_REQ:L.S_DOOR_REQ + nd]).view(np.int64)
+    key[:, 6:6 + nd] = np.ascontiguousarray(states[:, L.S_DOOR_REQ:L.S_DOOR_REQ + nd]).view(np.int64)
+    # robots 1..3's latched stops (inf in every state of a one-robot cell: the same partition and order as without)
+    key[:, 6 + nd:] = np.ascontiguousarray(states[:, L.S_XTSTOP:L.S_XTSTOP + nx]).view(np.int64)
     return np.ascontiguousarray(key).view(np.dtype((np.void, key.dtype.itemsize * key.shape[1]))).ravel()
 
 

@@ -26,6 +26,7 @@ from cellstress.sim.kernels.robot import (
     fastest_joint_speed,
     forward_kinematics,
     joint_trajectory,
+    other_robots,
     robot_capsules,
     robot_live,
     robot_table,
@@ -44,6 +45,7 @@ from cellstress.sim.kernels.step import (
 __all__ = [
     "SimParams", "Work", "make_work",
     "robot_live", "joint_trajectory", "forward_kinematics", "fastest_joint_speed", "robot_capsules", "robot_table",
+    "other_robots",
     "human_pose", "pose_body",
     "near_fences", "collect_near_fences", "fence_detour",
     "reach_value", "TRACE_REL_TOL",

@@ -14,17 +14,23 @@ import numpy as np
 
 from cellstress.core.jit import njit
 from cellstress.sim.geometry import point_segment_2d
-from cellstress.sim.layout import C_CYCLE, C_PHASE0, C_STOP_TIME, S_DOOR_OPEN, S_DOOR_REQ, S_TSTOP
+from cellstress.sim.layout import C_CYCLE, C_PHASE0, C_STOP_TIME, S_DOOR_OPEN, S_DOOR_REQ, S_TSTOP, S_XTSTOP
 
 FAR = 1.0e6  # m: where a passable door's leaf is put: a point this far off is near nothing
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def robot_at_rest(P, state, t):
-    """The robot stands at t: its latched stop took effect at least one stopping time ago. Braking from full
-    speed takes exactly that long (``robot.path_time``), from a reduced speed less, so this is never early.
-    (One robot; with several, the robots the door stops.)"""
-    return t - state[S_TSTOP] >= P.scal[C_STOP_TIME]
+def robots_at_rest(P, state, d, t):
+    """Every robot channel d stops stands at t: its latched stop took effect at least its stopping time ago.
+    Braking from full speed takes exactly that long (``robot.path_time``), from a reduced speed less, so this is
+    never early."""
+    mask = P.dev_robots[d]
+    if mask & 1 and t - state[S_TSTOP] < P.scal[C_STOP_TIME]:
+        return False
+    for r in range(P.x_scal.shape[0]):
+        if mask >> (r + 1) & 1 and t - state[S_XTSTOP + r] < P.x_scal[r, C_STOP_TIME]:
+            return False
+    return True
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -90,9 +96,10 @@ def push_doors(P, state, r, x, y, t):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def unlock_doors(P, state, t):
-    """Guard locking: a pushed door that is still locked starts to open at t if the robot is at rest."""
+    """Guard locking: a pushed door that is still locked starts to open at t if the robots it stops are at rest."""
     for i in range(P.door_dev.shape[0]):
-        if state[S_DOOR_REQ + i] <= t and state[S_DOOR_OPEN + i] == np.inf and robot_at_rest(P, state, t):
+        if state[S_DOOR_REQ + i] <= t and state[S_DOOR_OPEN + i] == np.inf and robots_at_rest(
+                P, state, P.door_dev[i], t):
             state[S_DOOR_OPEN + i] = t
 
 

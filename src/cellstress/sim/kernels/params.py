@@ -54,6 +54,30 @@ class SimParams(NamedTuple):
     pre_rb: np.ndarray
     pre_v: np.ndarray  # (n_pre,) v_R
     pre_tau: np.ndarray  # (n_pre,) path time
+    # Several robots. Robot 0 is the arrays above (a one-robot cell is exactly what it was); robots 1.. are the
+    # x_ arrays, one row each, padded to the largest (padding joints are fixed and unmoved, padding capsules
+    # never read, padding segments start at inf). Every robot's capsules are in cap_r, W.ra, pre_ra, robot 0's
+    # first; cap_a, cap_b and cap_joint hold robot 0's.
+    cap_robot: np.ndarray  # (nc,) int64 the robot owning each capsule
+    dev_robots: np.ndarray  # (nd,) int64 bit r set: the channel's stop stops robot r
+    x_scal: np.ndarray  # (nx, N_SCAL) scal with robot r's stopping time, phase, cycle, linear
+    x_base: np.ndarray  # (nx, 4, 4)
+    x_parents: np.ndarray  # (nx, njx) int64
+    x_placements: np.ndarray  # (nx, njx, 4, 4)
+    x_axes: np.ndarray  # (nx, njx, 3)
+    x_jtype: np.ndarray  # (nx, njx) int64
+    x_anc: np.ndarray  # (nx, njx, njx)
+    x_wp: np.ndarray  # (nx, nwx, njx)
+    x_seg_start: np.ndarray  # (nx, nwx)
+    x_seg_move: np.ndarray
+    x_seg_dwell: np.ndarray
+    x_cap_joint: np.ndarray  # (nx, ncx) int64
+    x_cap_a: np.ndarray  # (nx, ncx, 3)
+    x_cap_b: np.ndarray
+    x_cap0: np.ndarray  # (nx,) int64 robot r's first capsule in cap_r
+    x_ncap: np.ndarray  # (nx,) int64 its number of capsules
+    pre_xv: np.ndarray  # (n_pre, nx) v_R of robot r before its stop
+    pre_xtau: np.ndarray  # (n_pre, nx) its path time
 
 
 class Work(NamedTuple):
@@ -74,12 +98,22 @@ class Work(NamedTuple):
     ts: np.ndarray
     stopped: np.ndarray  # (2,) t_stop, v_R of the standstill pose held in ra/rb, or NaN (see robot_at)
     fences: np.ndarray  # P.fences with every passable door's leaf moved out of the way (kernels.doors)
+    xq: np.ndarray  # robots 1..: scratch for one robot at a time (njx,)
+    xqd: np.ndarray
+    xrot: np.ndarray
+    xpos: np.ndarray
+    xra: np.ndarray  # (ncx, 3)
+    xrb: np.ndarray
+    xv: np.ndarray  # (nx,) each robot's v_R at the step
+    xtau: np.ndarray  # (nx,) path time
+    xphase: np.ndarray  # (nx,) stop phase
 
 
 @njit(cache=True, error_model="numpy")
 def make_work(P):
     nj = P.placements.shape[0]
     nc = P.cap_r.shape[0]
+    nx, njx, ncx = P.x_parents.shape[0], P.x_parents.shape[1], P.x_cap_joint.shape[1]
     return Work(
         np.zeros(nj), np.zeros(nj), np.zeros((nj, 3, 3)), np.zeros((nj, 3)),
         np.zeros((nc, 3)), np.zeros((nc, 3)),
@@ -87,4 +121,6 @@ def make_work(P):
         np.zeros((2, 3)), np.zeros((3, 3)), np.zeros(P.fences.shape[0] + 1, dtype=np.int64),
         np.zeros(3),
         np.zeros(2 * nc), np.zeros(2 * nc), np.full(2, np.nan), P.fences.copy(),
+        np.zeros(njx), np.zeros(njx), np.zeros((njx, 3, 3)), np.zeros((njx, 3)), np.zeros((ncx, 3)),
+        np.zeros((ncx, 3)), np.zeros(nx), np.zeros(nx), np.zeros(nx),
     )

@@ -26,6 +26,7 @@ from cellstress.sim.layout import (
     C_PHASE0,
     C_STOP_TIME,
     JOINT_PRISMATIC,
+    NS,
     PHASE_BRAKING,
     PHASE_PENDING,
     PHASE_REDUCED,
@@ -39,6 +40,7 @@ from cellstress.sim.layout import (
     S_SLOW,
     S_TSLOW,
     S_TSTOP,
+    S_XTSTOP,
 )
 
 
@@ -321,11 +323,49 @@ def robot_at(P, k, state, W):
     return v, phase, tau
 
 
+# Not inlined, and called only when a cell has several robots: a one-robot step compiles and runs as before.
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def other_robots(P, k, state, W):
+    """Robots 1.. at step k: each one's capsules into its rows of W.ra/W.rb, its v_R, path time and stop phase
+    into W.xv, W.xtau, W.xphase. Each follows ``path_time`` with its own stopping time, phase and latched stop
+    (state[S_XTSTOP + r]); before that stop it comes from the pre-stop table, as robot 0 does."""
+    ra, rb, xra, xrb = W.ra, W.rb, W.xra, W.xrb
+    for r in range(P.x_scal.shape[0]):
+        scal = P.x_scal[r]
+        t = k * scal[C_DT]
+        t_stop = state[S_XTSTOP + r]
+        c0 = P.x_cap0[r]
+        if t < t_stop and k < P.pre_xv.shape[0]:
+            for c in range(c0, c0 + P.x_ncap[r]):
+                for i in range(3):
+                    ra[c, i] = P.pre_ra[k, c, i]
+                    rb[c, i] = P.pre_rb[k, c, i]
+            W.xv[r], W.xtau[r] = P.pre_xv[k, r], P.pre_xtau[k, r]
+            W.xphase[r] = PHASE_RUNNING if t_stop == np.inf else PHASE_PENDING
+            continue
+        tau, sigma, phase = path_time(scal, t, t_stop)
+        W.xv[r] = _robot_live(scal, P.x_seg_start[r], P.x_seg_move[r], P.x_seg_dwell[r], P.x_wp[r], P.x_parents[r],
+                              P.x_placements[r], P.x_base[r], P.x_axes[r], P.x_jtype[r], P.x_anc[r],
+                              P.x_cap_joint[r], P.x_cap_a[r], P.x_cap_b[r], W.xq, W.xqd, W.xrot, W.xpos, xra, xrb,
+                              tau, sigma)
+        W.xtau[r], W.xphase[r] = tau, phase
+        for c in range(P.x_ncap[r]):
+            for i in range(3):
+                ra[c0 + c, i] = xra[c, i]
+                rb[c0 + c, i] = xrb[c, i]
+
+
 @njit(cache=True, error_model="numpy")
-def robot_table(P, n, ra, rb, v, tau):
-    """Fill the pre-stop robot table for steps 0..n-1."""
+def robot_table(P, n, ra, rb, v, tau, xv, xtau):
+    """Fill the pre-stop robot table for steps 0..n-1 (robots 1.. too, into xv and xtau)."""
     W = make_work(P)
+    state = np.full(NS, np.inf)  # only the robots' stops are read: none latched
+    nx = P.x_scal.shape[0]
     for k in range(n):
         v[k], _, tau[k] = robot_live(P, k * P.scal[C_DT], np.inf, W)
+        if nx > 0:
+            other_robots(P, np.int64(k), state, W)
+            for r in range(nx):
+                xv[k, r], xtau[k, r] = W.xv[r], W.xtau[r]
         ra[k] = W.ra
         rb[k] = W.rb

@@ -16,7 +16,7 @@ from cellstress.sim.kernels.body import pose_body
 from cellstress.sim.kernels.doors import door_signals, muted, note_push, place_doors, push_doors, unlock_doors
 from cellstress.sim.kernels.fences import collect_near_fences
 from cellstress.sim.kernels.reach import reach_value_at
-from cellstress.sim.kernels.robot import live_path_time, robot_at
+from cellstress.sim.kernels.robot import live_path_time, other_robots, robot_at
 from cellstress.sim.kernels.sensing import device_sees, feet_ok, trunk_clear
 from cellstress.sim.kernels.separation import separation
 from cellstress.sim.layout import (
@@ -34,7 +34,9 @@ from cellstress.sim.layout import (
     M_FWD,
     M_HEADING,
     M_LAT,
+    M_LINK,
     M_PHASE,
+    M_ROBOT,
     M_SEEN,
     M_STEP,
     M_T,
@@ -42,8 +44,11 @@ from cellstress.sim.layout import (
     M_UNSAFE,
     M_V,
     M_X,
+    M_XPHASE,
+    M_XTAU,
     M_Y,
     MAX_DOORS,
+    MAX_ROBOTS,
     N_BODY_CAPSULES,
     NS,
     S_A_SIG,
@@ -70,6 +75,7 @@ from cellstress.sim.layout import (
     S_TSTOP,
     S_UNSAFE,
     S_X,
+    S_XTSTOP,
     S_Y,
 )
 
@@ -101,6 +107,9 @@ def sense_and_measure(P, state, W, row, action):
     place_doors(P, state, W.fences, t)
     n_near = collect_near_fences(W.fences, sh, W.near, P.body[B_ARM_LEN] + 0.05)
     v, phase, tau = robot_at(P, int(k), state, W)
+    nx = P.x_scal.shape[0]
+    if nx > 0:
+        other_robots(P, np.int64(k), state, W)
     cap_r, reach, origin, grid_h, arm_len, fences = P.cap_r, P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], \
         P.body[B_ARM_LEN], W.fences
     ra, rb, near, lbs, ts, q = W.ra, W.rb, W.near, W.lbs, W.ts, W.best_r
@@ -108,7 +117,17 @@ def sense_and_measure(P, state, W, row, action):
     # compile for no measurable speed (the fence code is skipped by a branch on n_near either way).
     d_hr = separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
                       n_near, row)
+    # v_R is the speed of the robot that owns the nearest capsule: the contact criterion and the reward judge
+    # the robot the worker is nearest (docs/architecture.md, several robots)
+    link = int(row[M_LINK])
+    owner = -1 if link < 0 else P.cap_robot[link]
+    if owner > 0:
+        v = W.xv[owner - 1]
     unsafe = d_hr <= P.scal[C_DTOL] and v > P.scal[C_VTOL]
+    row[M_ROBOT] = owner
+    for r in range(MAX_ROBOTS - 1):
+        row[M_XTAU + r] = W.xtau[r] if r < nx else -1.0  # (not NaN: rows are compared with array_equal)
+        row[M_XPHASE + r] = W.xphase[r] if r < nx else -1.0
     row[M_T] = t
     row[M_X], row[M_Y], row[M_HEADING] = state[S_X], state[S_Y], state[S_HEADING]
     row[M_FWD], row[M_LAT] = state[S_FWD], state[S_LAT]
@@ -127,8 +146,14 @@ def sense_and_measure(P, state, W, row, action):
 @njit(cache=True, error_model="numpy", inline="always")
 def sense_stop(P, state, d, t):
     """Device d sees the worker at t: a stop is latched, taking effect after its response time (an earlier one
-    replaces a later one)."""
+    replaces a later one), for each robot the device stops (robot 0 below; robots 1.. their own TSTOP)."""
     t_s = t + P.dev_resp[d]
+    mask = P.dev_robots[d]
+    for r in range(P.x_scal.shape[0]):
+        if mask >> (r + 1) & 1 and t_s < state[S_XTSTOP + r]:
+            state[S_XTSTOP + r] = t_s
+    if not mask & 1:
+        return
     # the clear time a latched stop waits for: its first device's, then the longest of those that see
     state[S_STOP_CLEAR] = P.dev_clear[d] if state[S_TSTOP] == np.inf else max(state[S_STOP_CLEAR], P.dev_clear[d])
     if t_s < state[S_TSTOP]:
@@ -211,6 +236,8 @@ def reset_state(P, x, y, heading, state, W, row):
     state[S_STOP_CLEAR] = state[S_SLOW_CLEAR] = np.inf  # nothing to release (a stop set by hand holds, as before)
     for i in range(MAX_DOORS):  # every door closed, none pushed
         state[S_DOOR_REQ + i] = state[S_DOOR_OPEN + i] = np.inf
+    for r in range(MAX_ROBOTS - 1):
+        state[S_XTSTOP + r] = np.inf
     sense_and_measure(P, state, W, row, np.int64(-1))  # not a literal: see batch.py
 
 

@@ -1,0 +1,94 @@
+"""The static check's report as text: the lines ``cellstress check`` prints (``StaticCheck.lines``)."""
+
+from __future__ import annotations
+
+import math
+
+from cellstress.analysis.hazard_zone import Closest
+
+
+def _xy(p) -> str:
+    return f"({p[0]:.2f}, {p[1]:.2f})"
+
+
+def _verdict(ok: bool) -> str:
+    return "ok" if ok else "FAIL"
+
+
+def _where(w: Closest | None, cycle: float) -> str:
+    if w is None:
+        return ""
+    return (f" at {_xy(w.point)} -> {_xy(w.hazard_point)}: {w.robot_part} at t = {w.t:.2f} s "
+            f"(episode time, mod {cycle:.2f} s)")
+
+
+def check_lines(r) -> list[str]:
+    """The lines of a ``StaticCheck``."""
+    z = r.zone
+    x0, x1, y0, y1 = z.extent()
+    each = f" ({', '.join(f'{n} {c:.2f} s' for n, c in r.robot_cycles)}: each robot over its own)" \
+        if r.robot_cycles else ""
+    out = [f"hazard zone: robot capsules over one {z.cycle:.2f} s cycle{each} every {z.sample_dt * 1000:.0f} ms, "
+           f"x {x0:.3f}..{x1:.3f} m, y {y0:.3f}..{y1:.3f} m"]
+    cycles = dict(r.robot_cycles)
+    for d in r.devices:
+        whose = f", stopping robot {d.robot}" if d.robot else ""
+        out.append(f"{d.device} ({d.type}{whose}): T = {d.response_time:.2f} + {d.stopping_time:.2f} s, {d.formula}")
+        if d.field_edges and not d.entries:
+            out.append("  no open field edge: every edge lies along a fence, the table or the floor's edge")
+        if d.field_edges:
+            for q0, q1, dist in d.entries:
+                out.append(f"  open edge {_xy(q0)}-{_xy(q1)}: {dist:.3f} m to the hazard zone, "
+                           f"needs {d.required:.3f} m: {_verdict(dist >= d.required - 1e-9)}")
+        where = _where(d.where, cycles.get(d.robot, z.cycle))
+        out.append(f"  {d.device}: {d.actual:.3f} m >= {d.required:.3f} m? {_verdict(d.ok)}{where}")
+        if r.phase_fixed and math.isfinite(d.episode_actual) and d.episode_actual > d.actual + 5e-4:
+            out.append(f"    (during one episode, t = 0..{r.episode:.2f} s from the cell's phase, "
+                       f"the robot comes no closer than {d.episode_actual:.3f} m)")
+        if d.note:
+            out.append(f"  {d.note}")
+    closed = [p for p in r.fences if p.closed]
+    open_ = [p for p in r.fences if not p.closed]
+    if closed:
+        p = min(closed, key=lambda q: q.over_top)
+        out.append(f"fences: {len(closed)} of {len(r.fences)} panels close the way; nearest reach over a top: "
+                   f"{p.top:.2f} - {r.shoulder_height:.3f} (shoulder) + {p.to_hazard:.3f} = {p.over_top:.3f} m "
+                   f">= {r.approach.arm_allowance:.2f} m ({_xy(p.start)}-{_xy(p.end)})")
+    for p in open_:
+        out.append(f"  panel {_xy(p.start)}-{_xy(p.end)} counts as open: {p.reason}")
+    for a in (r.approach, *r.robot_approaches):
+        out += _approach_lines(a, cycles.get(a.robot, z.cycle))
+    for rc in r.restarts:
+        b = rc.behind
+        out.append(f"{rc.device}: automatic restart after {rc.clear_time:g} s clear; a worker who crossed it stands "
+                   f"unseen on {b.undetected_area:.1f} m^2 next to it")
+        if b.where is None:
+            out.append(f"  from there the hazard zone cannot be reached: {_verdict(rc.ok)}")
+        else:
+            out.append(f"  closest: stand at {_xy(b.stand)}, shoulder at {_xy(b.where.point)}, arm path "
+                       f"{b.distance:.3f} m >= {b.arm_allowance:.2f} m? {_verdict(rc.ok)}{_where(b.where, z.cycle)}"
+                       + ("" if rc.ok else ": the robot restarts while the worker stands unseen within reach"))
+    out += [m.line() for m in r.mutings]
+    fails = r.failures()
+    out.append("result: pass" if not fails else f"result: FAIL ({', '.join(fails)})")
+    return out
+
+
+def _approach_lines(a, cycle: float) -> list[str]:
+    out = []
+    margins = [f">{m:.2f} m from {what}" for m, what in ((a.scanner_margin, "scanner fields"),
+                                                         (a.curtain_margin, "curtains")) if m is not None]
+    where = f"stand {' and '.join(margins)}" if margins else "no detection zone to keep away from"
+    whose = f" to robot {a.robot}'s hazard zone (devices that stop it: {', '.join(a.guards) or 'none'})" \
+        if a.robot else ""
+    head = (f"undetected reach{whose} from {_xy(a.start)}: {where} ({a.undetected_area:.1f} m^2), lean {a.lean:.3f} m, "
+            f"arm {a.arm_allowance:.2f} m")
+    out.append(head)
+    if a.start_detected:
+        out.append("  the start point is inside a detection zone: no undetected approach")
+    elif a.where is None:
+        out.append(f"  the hazard zone cannot be reached around the fences: {_verdict(a.ok)}")
+    else:
+        out.append(f"  closest: stand at {_xy(a.stand)}, shoulder at {_xy(a.where.point)}, arm path "
+                   f"{a.distance:.3f} m >= {a.arm_allowance:.2f} m? {_verdict(a.ok)}{_where(a.where, cycle)}")
+    return out
