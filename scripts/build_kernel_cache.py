@@ -53,6 +53,8 @@ COMMANDS = [
     ["search", "mat-short", "--searcher", "random", "--budget", "20", "--seed", "0", "--out", "{out}/mat"],
     ["search", "door-unlocked", "--searcher", "plan", "--budget", "20", "--seed", "0", "--out", "{out}/door"],
     ["search", "muting-long", "--searcher", "random", "--budget", "20", "--seed", "0", "--out", "{out}/mute"],
+    ["search", "two-robots", "--searcher", "plan", "--budget", "20", "--seed", "0", "--out", "{out}/two"],
+    ["verify", "two-robots", "--horizon", "2", "--out", "{out}/v2"],
     ["simulate", "s3-fence-gap", "--actions", "walk+upright,walk+upright"],
     ["check", "s3-fence-gap"],
     ["show", "s3-fence-gap", "--out", "{out}/show.png"],
