@@ -26,7 +26,7 @@ def safeguard_words(layout, records, unsafe_row: int) -> str | None:
     P = layout.params
     names = layout.device_names
     warn = {names[i]: (float(P.dev_speed[i]), float(P.dev_resp[i])) for i in range(len(names))
-            if P.dev_speed[i] != 0.0}
+            if P.dev_speed[i] > 0.0}
     stop_names = {names[i] for i in range(len(names)) if P.dev_speed[i] == 0.0}
     doors = {names[int(d)]: (float(P.door_open[i]), P.door_lock[i] != 0.0) for i, d in enumerate(P.door_dev)}
     parts, seen_warn = [], set()
