@@ -149,5 +149,5 @@ class SpeedSeparation(DeviceRecord):
         ax.add_patch(Polygon(self.polygon, closed=True, facecolor=self.color, alpha=0.12, edgecolor=self.color,
                              lw=1.2, ls="-.", hatch="//", zorder=2.45))
         return Patch(facecolor=self.color, alpha=0.3, edgecolor=self.color, hatch="//", ls="-.",
-                     label=f"speed & separation '{self.name}' ({self.height:g} m, v_max {self.max_speed:g} m/s, "
-                           f"T_r {self.reaction_time:g}/{self.response_time:g} s configured/real)")
+                     label=f"speed & separation '{self.name}' (T_r set {self.reaction_time:g} s, real "
+                           f"{self.response_time:g} s)")
