@@ -15,8 +15,8 @@ import statistics
 from cellstress.searchers import search
 from cellstress.sim.simulator import Simulator
 
-FLAWED = ("restart-auto", "warning-field-short", "mat-short", "door-unlocked", "muting-long")
-TWINS = ("restart-manual", "warning-field-ok", "mat-ok", "door-locked", "muting-ok")
+FLAWED = ("restart-auto", "warning-field-short", "mat-short", "door-unlocked", "muting-long", "ssm-latency")
+TWINS = ("restart-manual", "warning-field-ok", "mat-ok", "door-locked", "muting-ok", "ssm-ok")
 
 
 def main() -> None:

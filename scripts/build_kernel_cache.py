@@ -55,6 +55,7 @@ COMMANDS = [
     ["search", "muting-long", "--searcher", "random", "--budget", "20", "--seed", "0", "--out", "{out}/mute"],
     ["search", "two-robots", "--searcher", "plan", "--budget", "20", "--seed", "0", "--out", "{out}/two"],
     ["verify", "two-robots", "--horizon", "2", "--out", "{out}/v2"],
+    ["search", "ssm-latency", "--searcher", "plan", "--budget", "20", "--seed", "0", "--out", "{out}/ssm"],
     ["simulate", "s3-fence-gap", "--actions", "walk+upright,walk+upright"],
     ["check", "s3-fence-gap"],
     ["show", "s3-fence-gap", "--out", "{out}/show.png"],

@@ -85,6 +85,11 @@ def _scanner(cell: dict) -> dict:
     return cell["devices"][_index(cell, "laser-scanner")]
 
 
+def _ssm(name: str = "ssm", **kw) -> dict:
+    return {"type": "speed-separation", "name": name, "polygon": [[-1.5, 3.0], [1.5, 3.0], [1.5, 2.0], [-1.5, 2.0]],
+            "reaction_time": 0.1, "stopping_time": 0.15, "max_speed": 1.2, **kw}
+
+
 def _door(i: int) -> dict:
     return {"type": "guard-door", "name": f"door-{i}", "start": [-0.6, -2.0 - i], "end": [0.6, -2.0 - i]}
 
@@ -260,6 +265,42 @@ CASES = [
         None,
         ("before the pallet has passed",),
         lambda c: f"devices[{_index(c, 'light-curtain')}].muting",
+    ),
+    # speed and separation monitoring (issue 18)
+    Case(
+        "ssm-max-speed-zero",
+        lambda c: c["devices"].append(_ssm(max_speed=0)),
+        None,
+        ("greater than 0",),
+        lambda c: f"devices[{len(c['devices']) - 1}].max_speed",
+    ),
+    Case(
+        "ssm-automatic-restart",
+        lambda c: c["devices"].append(_ssm(restart={"automatic": 1.0})),
+        None,
+        ("takes no restart field",),
+        lambda c: f"devices[{len(c['devices']) - 1}]",
+    ),
+    Case(
+        "ssm-missing-reaction-time",
+        lambda c: c["devices"].append({k: v for k, v in _ssm().items() if k != "reaction_time"}),
+        None,
+        ("required field is missing",),
+        lambda c: f"devices[{len(c['devices']) - 1}].reaction_time",
+    ),
+    Case(
+        "ssm-response-beyond-the-queue",
+        lambda c: c["devices"].append(_ssm(response_time=2.0)),
+        None,
+        ("must be at most",),
+        lambda c: f"devices[{len(c['devices']) - 1}].response_time",
+    ),
+    Case(
+        "ssm-two-devices",
+        lambda c: c["devices"].extend([_ssm("ssm-a"), _ssm("ssm-b")]),
+        None,
+        ("one speed-separation device",),
+        lambda c: f"devices[{len(c['devices']) - 1}]",
     ),
     Case("start-inside-table", _put_table_on_start, "human.start.xy", ("table",)),
     Case("start-off-floor", _start_off_floor, "human.start.xy", ("not on the floor",)),

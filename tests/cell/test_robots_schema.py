@@ -45,6 +45,11 @@ CASES = [
      "robots[1].task", ("one per waypoint",)),
     ("automatic-restart-with-two-robots", lambda c: c["devices"][0].update(restart={"automatic": 0.5}),
      "devices[0]", ("automatic restart", "several robots")),
+    ("speed-separation-with-two-robots", lambda c: c["devices"].append(
+        {"type": "speed-separation", "name": "ssm", "polygon": [[-1.0, 3.0], [1.0, 3.0], [1.0, 2.5], [-1.0, 2.5]],
+         "reaction_time": 0.3, "stopping_time": 0.15, "max_speed": 1.2}),
+     f"devices[{len(yaml.safe_load(builtin_text('two-robots'))['devices'])}]",
+     ("speed and separation monitoring", "several robots")),
 ]
 
 

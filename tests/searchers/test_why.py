@@ -137,3 +137,20 @@ def test_no_safeguard_words_in_old_results(s1):
     res = search(s1, "plan", budget=200, seed=0)
     assert res.hazard.why.safeguards is None
     assert "safeguards" not in res.hazard.why.model_dump()
+
+
+def test_speed_separation_in_words(tmp_path):
+    """ssm-latency: no device stops the robot (the monitor commands speeds); the words say when it measured and
+    when its first cut took effect, and the static check's S_p with the real times against what the controller
+    allowed; the result replays (the command queue included)."""
+    sim = Simulator("ssm-latency")
+    res = search(sim, "plan", budget=200, seed=0)
+    why = res.hazard.why
+    assert not why.detected and why.stopped_by is None
+    assert "ssm measured the worker from" in why.safeguards and "first speed cut took effect at" in why.safeguards
+    words = shortfall(why, check_cell(sim.cell))
+    assert words.startswith("no device stopped the robot before the contact")
+    assert "requires S_p = 2.25 m" in words and "real reaction time 0.3 s" in words
+    assert "allowed full speed down to 1.55 m (short by 0.70 m)" in words
+    check = check_result(SearchResult.load(res.write(tmp_path)), search_again=True)
+    assert check.reproduced, check.problems

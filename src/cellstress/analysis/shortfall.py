@@ -21,6 +21,14 @@ def distance_words(why: Why, static: StaticCheck) -> str:
         whose = f" robot {d.robot}'s" if d.robot else ""
         return (f"ISO 13855 requires S = {d.required:.2f} m; {d.device} stands {d.actual:.2f} m from the"
                 f"{whose} hazard zone ({verdict} {gap:.2f} m)")
+    sep = [d for d in static.devices if d.type == "speed-separation" and why.safeguards is not None
+           and f"{d.device} measured the worker" in why.safeguards]
+    if sep:
+        d = sep[0]
+        verdict = "short by" if not d.ok else "met, with"
+        return (f"ISO/TS 15066 requires S_p = {d.required:.2f} m at full speed with the real reaction time "
+                f"{d.response_time:g} s and stopping time {d.stopping_time:g} s; {d.device} allowed full speed down "
+                f"to {d.actual:.2f} m ({verdict} {abs(d.actual - d.required):.2f} m)")
     muted = [m for m in static.mutings if not m.ok]
     if muted:
         return "; ".join(f"{m.device} stayed muted {m.until - m.pallet_out:.2f} s after the pallet had cleared the "

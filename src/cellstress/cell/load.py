@@ -31,7 +31,7 @@ BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intr
                                   "s2-deceptive", "restart-auto", "restart-manual", "warning-field-short",
                                   "warning-field-ok", "mat-short", "mat-ok", "palletizing", "palletizing-fixed",
                                   "door-unlocked", "door-locked", "muting-long", "muting-ok",
-                                  "two-robots", "two-robots-fixed")
+                                  "two-robots", "two-robots-fixed", "ssm-latency", "ssm-ok")
 
 
 @dataclass(frozen=True)
@@ -403,8 +403,9 @@ def _check_robot_names(cell: Cell) -> None:
                 raise CellError(src, f"devices[{i}].stops[{j}]", f"names robot {n!r} twice")
         if len(names) > 1:
             for c in _channels(d):
-                if c.speed != 0.0 or c.clear_time != float("inf"):
-                    what = "a warning field" if c.speed != 0.0 else "an automatic restart"
+                if c.separation is not None or c.speed != 0.0 or c.clear_time != float("inf"):
+                    what = ("speed and separation monitoring" if c.separation is not None else
+                            "a warning field" if c.speed != 0.0 else "an automatic restart")
                     raise CellError(src, f"devices[{i}]", f"has {what}; a cell with several robots takes devices "
                                                           "whose stops are manual only (not implemented yet)")
 

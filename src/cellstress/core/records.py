@@ -126,6 +126,22 @@ class Channel:
     clear_time: float
     # muted (sees nothing) while the cell's clock, (phase + t) modulo the robot's cycle, lies in [on, off] [s]
     muted: tuple[float, float] | None = None
+    # speed and separation monitoring: the channel measures the worker's separation from the robot and commands
+    # a speed fraction from it (``speed`` is then ignored), as ``SeparationRule`` says
+    separation: SeparationRule | None = None
+
+
+@dataclass(frozen=True)
+class SeparationRule:
+    """How a speed and separation monitoring channel turns a measured separation S [m] into a speed fraction:
+    the largest s in [0, 1] with v_h (T_r + T_s) + s v_max (T_r + T_s / 2) + allowance <= S (ISO/TS 15066:2016,
+    5.5.4, with the times the controller was configured with)."""
+
+    human_speed: float  # v_h [m/s]
+    max_speed: float  # v_max [m/s]
+    reaction_time: float  # configured T_r [s]
+    stopping_time: float  # configured T_s [s]
+    allowance: float  # C + Z_d + Z_r [m]
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,7 @@ _PHASES = {"running": "no stop has been requested, the robot runs at full speed"
            "stop-pending": "a stop has been requested but has not taken effect yet",
            "braking": "the robot is braking but has not stopped",
            "stopped": "the robot has stopped",
-           "reduced-speed": "a warning field has cut the robot to its reduced speed"}
+           "reduced-speed": "a warning field or a speed and separation monitor has cut the robot's speed"}
 
 
 def link_words(name: str | None) -> str:

@@ -26,10 +26,11 @@ def safeguard_words(layout, records, unsafe_row: int) -> str | None:
     P = layout.params
     names = layout.device_names
     warn = {names[i]: (float(P.dev_speed[i]), float(P.dev_resp[i])) for i in range(len(names))
-            if P.dev_speed[i] != 0.0}
+            if P.dev_speed[i] > 0.0}
     stop_names = {names[i] for i in range(len(names)) if P.dev_speed[i] == 0.0}
+    parts = _separation_words(layout, records[: unsafe_row + 1])
     doors = {names[int(d)]: (float(P.door_open[i]), P.door_lock[i] != 0.0) for i, d in enumerate(P.door_dev)}
-    parts, seen_warn = [], set()
+    seen_warn: set[str] = set()
     last_stop_seen: tuple[str, float] | None = None
     prev = None
     first_stop = min((r.t + float(P.dev_resp[names.index(n)]) for r in records[: unsafe_row + 1] for n in r.devices
@@ -56,6 +57,26 @@ def safeguard_words(layout, records, unsafe_row: int) -> str | None:
         return None
     hit = records[unsafe_row]
     return "; ".join(parts) + f"; v_R at the contact {hit.v_R:.2f} m/s ({hit.stop_phase})"
+
+
+def separation_devices(layout) -> set[str]:
+    """Names of the channels that set the speed from the measured separation (speed and separation monitoring)."""
+    P = layout.params
+    return {layout.device_names[i] for i in range(len(layout.device_names)) if P.dev_speed[i] == L.SEPARATION}
+
+
+def _separation_words(layout, records) -> list[str]:
+    """When the separation monitor first saw the worker, when its first speed cut took effect (the rows' phase
+    turns ``reduced-speed``), and the robot's speed at the end."""
+    out = []
+    for name in sorted(separation_devices(layout)):
+        seen = next((r.t for r in records if name in r.devices), None)
+        if seen is None:
+            continue
+        cut = next((r.t for r in records if r.stop_phase == "reduced-speed"), None)
+        when = "it had not cut the speed yet" if cut is None else f"its first speed cut took effect at {cut:.2f} s"
+        out.append(f"{name} measured the worker from {seen:.2f} s; {when}")
+    return out
 
 
 def _muting_words(layout, records) -> list[str]:
@@ -113,7 +134,8 @@ def explain(layout, records, unsafe_row: int) -> Why:
             note = f"{', '.join(others)} saw the worker but {'does' if len(others) == 1 else 'do'} not stop " \
                    f"robot {robot.name}"
             words = note if words is None else f"{note}; {words}"
-    stopping = {d.name for d in spec.devices if len(layout.robots) < 2 or stops_robot(d, robot.name)}
+    stopping = {d.name for d in spec.devices if len(layout.robots) < 2 or stops_robot(d, robot.name)} - \
+        separation_devices(layout)  # (a separation monitor commands speeds; its stop is one of them)
     response = {d.name: float(d.response_time) for d in spec.devices}
     saw: dict[str, float] = {}
     for r in records[: unsafe_row + 1]:
@@ -142,6 +164,8 @@ def why_words(why: Why) -> str:
             # several robots: seen, but by no device that stops the robot touched
             return f"no device that stops the touched robot saw the worker before the contact at " \
                    f"{why.contact_at_s:.2f} s{extra}"
+        if why.safeguards is not None and " measured the worker from " in why.safeguards:
+            return f"no device stopped the robot before the contact at {why.contact_at_s:.2f} s{extra}"
         return f"undetected: no device saw the worker before the contact at {why.contact_at_s:.2f} s{extra}"
     first = next(t for t in why.devices if t.device == why.stopped_by)
     late = why.late_by_s

@@ -10,6 +10,7 @@ import numpy as np
 from cellstress.cell.load import Cell
 from cellstress.cell.program import held_joints, robot_program
 from cellstress.cell.schema import ObstacleSpec, RobotSpec
+from cellstress.core.errors import CellError
 from cellstress.core.protocols import Channels, TimedPanels
 from cellstress.core.records import MAX_DOORS, Channel, DoorLeaf, ScanPlane, VerticalField
 from cellstress.devices.base import stops_of
@@ -37,9 +38,11 @@ class DeviceArrays:
     poly: np.ndarray  # (nd, 2) int64: start and count of each scan plane's polygon in verts
     verts: np.ndarray  # (V, 2)
     names: tuple[str, ...]
-    speed: np.ndarray  # (nd,) 0: the channel stops the robot; else the reduced speed's fraction
+    speed: np.ndarray  # (nd,) 0: the channel stops the robot; SEPARATION: it scales the speed; else the reduced
+    # speed's fraction
     clear: np.ndarray  # (nd,) s without detection before its stop or reduction is released; inf: manual
     muted: np.ndarray  # (nd, 2) clock window [on, off] in which the channel sees nothing; (inf, inf): never
+    separation: np.ndarray  # (n_sep, 6) each SEPARATION channel's rule: v_h, v_max, T_r, T_s, allowance, its row
 
 
 def pack_polygons(polys) -> tuple[np.ndarray, np.ndarray]:
@@ -53,24 +56,47 @@ def pack_polygons(polys) -> tuple[np.ndarray, np.ndarray]:
 
 def device_arrays(devices) -> DeviceArrays:
     """The kernel's arrays of the cell's devices, from each device's detection primitive."""
-    kinds, resp, rects, polys, names, speed, clear, muted = [], [], [], [], [], [], [], []
+    kinds, resp, rects, polys, names, speed, clear, muted, sep = [], [], [], [], [], [], [], [], []
     for d in devices:
         chans = d.channels() if isinstance(d, Channels) else \
             tuple(Channel(p, d.name, 0.0, d.response_time, np.inf) for p in d.primitives())
-        if sum(c.speed == 0.0 for c in chans) != 1:
-            raise NotImplementedError(f"device {d.name!r}: the kernel takes one stopping primitive per device")
+        n_sep = sum(c.separation is not None for c in chans)
+        if n_sep > 1 or (n_sep == 1 and len(chans) > 1) or \
+                (n_sep == 0 and sum(c.speed == 0.0 for c in chans) != 1):
+            raise NotImplementedError(f"device {d.name!r}: the kernel takes one stopping primitive per device, or "
+                                      "one speed-and-separation channel")
         for c in chans:
             _channel(d, c.primitive, kinds, rects, polys)
             resp.append(c.response_time)
             names.append(c.name)
-            speed.append(c.speed)
+            rule = c.separation
+            speed.append(c.speed if rule is None else L.SEPARATION)
+            if rule is not None:
+                sep.append((rule.human_speed, rule.max_speed, rule.reaction_time, rule.stopping_time, rule.allowance,
+                            len(names) - 1))
             clear.append(c.clear_time)
             muted.append((np.inf, np.inf) if c.muted is None else c.muted)
     verts, index = pack_polygons(polys)
     return DeviceArrays(np.asarray(kinds, dtype=np.int64), np.asarray(resp, dtype=float),
                         np.asarray(rects, dtype=float).reshape(-1, 6), index, verts, tuple(names),
                         np.asarray(speed, dtype=float), np.asarray(clear, dtype=float),
-                        np.asarray(muted, dtype=float).reshape(-1, 2))
+                        np.asarray(muted, dtype=float).reshape(-1, 2), np.asarray(sep, dtype=float).reshape(-1, 6))
+
+
+def _check_separation(cell: Cell, dev: DeviceArrays) -> None:
+    """The kernel keeps one separation channel's commands, at most SEP_QUEUE - 1 time steps in flight."""
+    spec, rows = cell.spec, dev.separation
+    if rows.shape[0] == 0:
+        return
+    i = next(i for i, d in enumerate(spec.devices) if d.name == dev.names[int(rows[-1, 5])])
+    if rows.shape[0] > 1:
+        raise CellError(cell.source, f"devices[{i}]", "a cell takes one speed-separation device (not implemented "
+                                                      "for several)")
+    limit = (L.SEP_QUEUE - 1) * spec.simulation.dt
+    if dev.response[int(rows[0, 5])] > limit + 1e-12:
+        raise CellError(cell.source, f"devices[{i}].response_time", f"must be at most {limit:g} s "
+                                                                    f"({L.SEP_QUEUE - 1} time steps of "
+                                                                    f"{spec.simulation.dt:g} s)")
 
 
 def _channel(d, prim, kinds, rects, polys) -> None:
@@ -213,6 +239,7 @@ def build_layout(cell: Cell) -> Layout:
     obs_verts, obs_poly, obs_box = obstacle_arrays(obstacles)
 
     dev = device_arrays(spec.devices)
+    _check_separation(cell, dev)
     doors = [d for d in range(len(dev.kind)) if dev.kind[d] == DOOR]
     if len(doors) > MAX_DOORS:  # (the cell schema refuses such a cell first)
         raise ValueError(f"{len(doors)} guard doors; the simulator takes at most {MAX_DOORS}")
@@ -286,6 +313,7 @@ def build_layout(cell: Cell) -> Layout:
         **_other_robot_arrays(spec, parts, scal),
         pre_xv=np.zeros((0, len(parts) - 1)),
         pre_xtau=np.zeros((0, len(parts) - 1)),
+        dev_sep=dev.separation,
     )
     params = _with_robot_table(params, spec)
     return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params, part0.joints, obstacles,

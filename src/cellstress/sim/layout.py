@@ -32,6 +32,8 @@ from cellstress.human.body import (  # noqa: F401  (re-exported: the kernels and
     N_CAPSULES,
 )
 
+SEP_QUEUE = 16  # speed commands in flight at most: a separation channel's response time is below 16 time steps
+_SEP_SLOTS = tuple(f"SEP_Q{i}" for i in range(1, SEP_QUEUE))  # (the kernels index them as S_SEP_Q0 + i)
 _DOOR_SLOTS = tuple(f"DOOR{i}_{what}" for what in ("REQ", "OPEN") for i in range(MAX_DOORS))
 
 STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
@@ -71,14 +73,24 @@ STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
     ("XTSTOP1", "time robot 1's latched stop takes effect [s]; inf: none latched (or no such robot)"),
     ("XTSTOP2", "the same for robot 2"),
     ("XTSTOP3", "the same for robot 3"),
+    # speed and separation monitoring (issue 18): the speed commands; appended, so the slots above never move
+    ("SEP_ON", "the speed fraction the separation monitor's command in effect allows (1 at reset)"),
+    *((f"SEP_Q{i}", f"the fraction commanded at a step k with k mod {SEP_QUEUE} = {i} (in flight until k dt + the "
+                    "response time); NaN: none") for i in range(SEP_QUEUE)),
+    ("SEP_LOW", "the lowest fraction commanded so far (1: none below full speed)"),
+    ("SEP_LOW_T", "time of the measurement that commanded SEP_LOW [s]; -1: none"),
+    ("SEP_LOW_S", "the separation measured then [m]; -1: none"),
 ))
 (S_K, S_X, S_Y, S_HEADING, S_FWD, S_LAT, S_TSTOP, S_TRIG_DEV, S_TRIG_T, S_UNSAFE, S_ACTIONS, S_LIVE, S_A_T, S_A_TAU,
  S_A_SIG, S_A_TGT, S_TSLOW, S_SLOW, S_STOP_SEEN, S_STOP_CLEAR, S_SLOW_SEEN, S_SLOW_CLEAR, S_RESTARTS,
  S_DOOR0_REQ, S_DOOR1_REQ, S_DOOR2_REQ, S_DOOR3_REQ, S_DOOR0_OPEN, S_DOOR1_OPEN, S_DOOR2_OPEN,
- S_DOOR3_OPEN, S_XTSTOP1, S_XTSTOP2, S_XTSTOP3) = STATE.indices(
+ S_DOOR3_OPEN, S_XTSTOP1, S_XTSTOP2, S_XTSTOP3, S_SEP_ON, S_SEP_Q0, S_SEP_Q1, S_SEP_Q2, S_SEP_Q3, S_SEP_Q4,
+ S_SEP_Q5, S_SEP_Q6, S_SEP_Q7, S_SEP_Q8, S_SEP_Q9, S_SEP_Q10, S_SEP_Q11, S_SEP_Q12, S_SEP_Q13, S_SEP_Q14, S_SEP_Q15,
+ S_SEP_LOW, S_SEP_LOW_T, S_SEP_LOW_S) = STATE.indices(
     "K", "X", "Y", "HEADING", "FWD", "LAT", "TSTOP", "TRIG_DEV", "TRIG_T", "UNSAFE", "ACTIONS", "LIVE", "A_T", "A_TAU",
     "A_SIG", "A_TGT", "TSLOW", "SLOW", "STOP_SEEN", "STOP_CLEAR", "SLOW_SEEN", "SLOW_CLEAR", "RESTARTS",
-    *_DOOR_SLOTS, "XTSTOP1", "XTSTOP2", "XTSTOP3")
+    *_DOOR_SLOTS, "XTSTOP1", "XTSTOP2", "XTSTOP3", "SEP_ON", "SEP_Q0", *_SEP_SLOTS, "SEP_LOW",
+    "SEP_LOW_T", "SEP_LOW_S")
 S_DOOR_REQ, S_DOOR_OPEN = S_DOOR0_REQ, S_DOOR0_OPEN  # door i's slots: these + i (the kernels index by door)
 NS = STATE.size
 S_XTSTOP = S_XTSTOP1  # robot r >= 1's stop is S_XTSTOP + r - 1 (the kernels loop over them)
@@ -155,6 +167,9 @@ DEVICE_KINDS = VectorSpec("detection primitive kinds (SimParams.dev_kind)", (
              "the time the worker pushes the door (its DOORi_REQ slot, i = the door's index in SimParams.door_dev)"),
 ))
 DEV_SCANNER, DEV_CURTAIN, DEV_DOOR = DEVICE_KINDS.indices("SCANNER", "CURTAIN", "DOOR")
+# SimParams.dev_speed of a channel that sets the speed from the measured separation (its rule in dev_sep),
+# instead of latching a stop (0) or a reduction (a fraction in (0, 1))
+SEPARATION = -1.0
 
 JOINT_KINDS = VectorSpec("robot joint kinds (SimParams.jtype)", (
     ("REVOLUTE", "turns by q [rad] about its axis"),

@@ -78,6 +78,9 @@ class SimParams(NamedTuple):
     x_ncap: np.ndarray  # (nx,) int64 its number of capsules
     pre_xv: np.ndarray  # (n_pre, nx) v_R of robot r before its stop
     pre_xtau: np.ndarray  # (n_pre, nx) its path time
+    # speed and separation monitoring, one row per channel whose dev_speed is layout.SEPARATION (at most one: the
+    # cell schema): v_h, v_max, configured T_r and T_s, allowance C + Z_d + Z_r, the channel's row of dev_*
+    dev_sep: np.ndarray  # (n_sep, 6)
 
 
 class Work(NamedTuple):

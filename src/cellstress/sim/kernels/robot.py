@@ -37,6 +37,7 @@ from cellstress.sim.layout import (
     S_A_TAU,
     S_A_TGT,
     S_LIVE,
+    S_SEP_ON,
     S_SLOW,
     S_TSLOW,
     S_TSTOP,
@@ -103,7 +104,7 @@ def live_path_time(scal, state, t):
         phase = PHASE_BRAKING if sig > 0.0 else PHASE_STOPPED
     elif t_stop < np.inf:
         phase = PHASE_PENDING
-    elif state[S_TSLOW] < np.inf:
+    elif state[S_TSLOW] < np.inf or state[S_SEP_ON] < 1.0:  # (a separation command below full speed too)
         phase = PHASE_REDUCED
     else:
         phase = PHASE_RUNNING

@@ -17,6 +17,7 @@ from cellstress.sim.kernels.doors import door_signals, muted, note_push, place_d
 from cellstress.sim.kernels.fences import collect_near_fences
 from cellstress.sim.kernels.reach import reach_value_at
 from cellstress.sim.kernels.robot import live_path_time, other_robots, robot_at
+from cellstress.sim.kernels.scaling import command, commands_due
 from cellstress.sim.kernels.sensing import device_sees, feet_ok, trunk_clear
 from cellstress.sim.kernels.separation import separation
 from cellstress.sim.layout import (
@@ -64,6 +65,11 @@ from cellstress.sim.layout import (
     S_LAT,
     S_LIVE,
     S_RESTARTS,
+    S_SEP_LOW,
+    S_SEP_LOW_S,
+    S_SEP_LOW_T,
+    S_SEP_ON,
+    S_SEP_Q0,
     S_SLOW,
     S_SLOW_CLEAR,
     S_SLOW_SEEN,
@@ -77,6 +83,7 @@ from cellstress.sim.layout import (
     S_X,
     S_XTSTOP,
     S_Y,
+    SEP_QUEUE,
 )
 
 
@@ -98,10 +105,11 @@ def sense_and_measure(P, state, W, row, action):
         if door_signals(P, state, d, t) if dev_kind[d] == DEV_DOOR else \
                 device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
             seen |= 1 << d
-            if P.dev_speed[d] != 0.0:  # a warning field: a speed reduction, latched like a stop
+            if P.dev_speed[d] > 0.0:  # a warning field: a speed reduction, latched like a stop
                 sense_warning(P, state, d, t)
-            else:
+            elif P.dev_speed[d] == 0.0:  # (a separation channel latches nothing: it commands below)
                 sense_stop(P, state, d, t)
+    commands_due(P, state, int(k))
     release(P, state, t)
     unlock_doors(P, state, t)
     place_doors(P, state, W.fences, t)
@@ -110,6 +118,7 @@ def sense_and_measure(P, state, W, row, action):
     nx = P.x_scal.shape[0]
     if nx > 0:
         other_robots(P, np.int64(k), state, W)
+    command(P, state, seen, int(k), W.ra, W.rb)  # a separation channel, if any (robot 0 posed at t)
     cap_r, reach, origin, grid_h, arm_len, fences = P.cap_r, P.reach, P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H], \
         P.body[B_ARM_LEN], W.fences
     ra, rb, near, lbs, ts, q = W.ra, W.rb, W.near, W.lbs, W.ts, W.best_r
@@ -173,9 +182,9 @@ def latch_seen(P, state, seen, t):
         if seen >> d & 1:
             if P.dev_kind[d] == DEV_DOOR:
                 note_push(P, state, d, t)
-            if P.dev_speed[d] != 0.0:
+            if P.dev_speed[d] > 0.0:
                 sense_warning(P, state, d, t)
-            else:
+            elif P.dev_speed[d] == 0.0:
                 sense_stop(P, state, d, t)
     release(P, state, t)
     unlock_doors(P, state, t)
@@ -204,12 +213,12 @@ def release(P, state, t):
     clear time is inf). The path is re-anchored there, in closed form, and ramps back up to full speed (or to
     the reduced speed, if a reduction is in effect); a later detection latches anew."""
     if state[S_TSTOP] < np.inf and t - state[S_STOP_SEEN] >= state[S_STOP_CLEAR]:
-        _reanchor(P, state, t, state[S_SLOW] if state[S_TSLOW] <= t else 1.0)
+        _reanchor(P, state, t, min(state[S_SEP_ON], state[S_SLOW] if state[S_TSLOW] <= t else 1.0))
         state[S_TSTOP] = np.inf
         state[S_STOP_CLEAR] = np.inf
         state[S_RESTARTS] += 1.0
     if state[S_TSLOW] < np.inf and t - state[S_SLOW_SEEN] >= state[S_SLOW_CLEAR]:
-        _reanchor(P, state, t, 0.0 if state[S_TSTOP] <= t else 1.0)
+        _reanchor(P, state, t, 0.0 if state[S_TSTOP] <= t else state[S_SEP_ON])
         state[S_TSLOW] = np.inf
         state[S_SLOW_CLEAR] = np.inf
 
@@ -238,6 +247,10 @@ def reset_state(P, x, y, heading, state, W, row):
         state[S_DOOR_REQ + i] = state[S_DOOR_OPEN + i] = np.inf
     for r in range(MAX_ROBOTS - 1):
         state[S_XTSTOP + r] = np.inf
+    state[S_SEP_ON] = state[S_SEP_LOW] = 1.0  # full speed, no command in flight
+    for i in range(SEP_QUEUE):
+        state[S_SEP_Q0 + i] = np.nan
+    state[S_SEP_LOW_T] = state[S_SEP_LOW_S] = -1.0
     sense_and_measure(P, state, W, row, np.int64(-1))  # not a literal: see batch.py
 
 
