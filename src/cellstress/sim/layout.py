@@ -76,7 +76,7 @@ STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
     # speed and separation monitoring (issue 18): the speed commands; appended, so the slots above never move
     ("SEP_ON", "the speed fraction the separation monitor's command in effect allows (1 at reset)"),
     *((f"SEP_Q{i}", f"the fraction commanded at a step k with k mod {SEP_QUEUE} = {i} (in flight until k dt + the "
-                    "response time); NaN: none") for i in range(SEP_QUEUE)),
+                    "response time); -1: none") for i in range(SEP_QUEUE)),
     ("SEP_LOW", "the lowest fraction commanded so far (1: none below full speed)"),
     ("SEP_LOW_T", "time of the measurement that commanded SEP_LOW [s]; -1: none"),
     ("SEP_LOW_S", "the separation measured then [m]; -1: none"),

@@ -52,7 +52,7 @@ def commands_due(P, state, k):
     for j in range(max(0, k - SEP_QUEUE + 1), k):
         t_c = j * dt + resp
         f = state[S_SEP_Q0 + j % SEP_QUEUE]
-        if not (t_prev < t_c <= t) or np.isnan(f) or f == state[S_SEP_ON]:
+        if not (t_prev < t_c <= t) or f < 0.0 or f == state[S_SEP_ON]:
             continue
         tgt = f
         if state[S_TSTOP] <= t_c:
