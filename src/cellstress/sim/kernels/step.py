@@ -249,7 +249,7 @@ def reset_state(P, x, y, heading, state, W, row):
         state[S_XTSTOP + r] = np.inf
     state[S_SEP_ON] = state[S_SEP_LOW] = 1.0  # full speed, no command in flight
     for i in range(SEP_QUEUE):
-        state[S_SEP_Q0 + i] = -1.0  # (not NaN: states are compared with array_equal)
+        state[S_SEP_Q0 + i] = -1.0  # none in flight (not NaN: states are compared with ==)
     state[S_SEP_LOW_T] = state[S_SEP_LOW_S] = -1.0
     sense_and_measure(P, state, W, row, np.int64(-1))  # not a literal: see batch.py
 
