@@ -6,6 +6,7 @@ import ast
 import json
 import os
 import pickle
+import platform
 import subprocess
 import sys
 import zipfile
@@ -79,7 +80,8 @@ def test_the_archive_matches_this_installation():
     manifest = jit.read_manifest()
     assert manifest is not None and manifest["cpu"] == "x86-64-v2" and manifest["machine"] == "x86_64"
     assert manifest["python"] == jit.python_tag()
-    assert jit.manifest_matches(manifest)
+    if platform.machine().lower() in ("x86_64", "amd64"):  # elsewhere numba compiles, as it should
+        assert jit.manifest_matches(manifest)
     assert jit.fresh_sources(manifest) == set(manifest["sources"])
     # every compiled module of the simulator is covered
     covered = set(manifest["indexes"].values())
