@@ -47,8 +47,6 @@ from cellstress.analysis.plane import (
 from cellstress.cell.load import Cell, load_cell
 from cellstress.core.records import DoorLeaf, ScanPlane, VerticalField
 from cellstress.devices.base import DeviceRecord, stops_robot
-from cellstress.devices.guard_door import GuardDoor
-from cellstress.devices.speed_separation import SpeedSeparation
 from cellstress.human.body import WALK_BLOCK_HEIGHT
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
@@ -220,10 +218,10 @@ def _device_checks(spec, zone: HazardZone, robot: str = "") -> tuple[DeviceCheck
         iso = d.required_distance(stop)
         entries, actual, where, ep = _entries_to_zone(d.primitives(), covers, zone, t_ep)
         required = iso.S / 1000.0
-        note = d.access_note(actual, stop) if isinstance(d, GuardDoor) else \
-            d.configured_note(stop) if isinstance(d, SpeedSeparation) else ""
-        if isinstance(d, SpeedSeparation):  # full speed is allowed down to the controller's own S_p (docs/cells.md)
-            actual = min(actual, d.configured_separation())
+        note = ""
+        own = getattr(d, "static_check", None)  # a device kind's own part (a guard door, speed and separation)
+        if own is not None:
+            actual, note = own(actual, stop)
         out.append(DeviceCheck(d.name, d.type, d.response_time, stop, iso.T, iso.K, iso.C, required,
                                actual, bool(actual >= required - 1e-9), iso.formula, where,
                                tuple(entries), ep, any(isinstance(p, ScanPlane) for p in d.primitives()), robot,

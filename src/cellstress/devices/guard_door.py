@@ -77,6 +77,11 @@ class GuardDoor(DeviceRecord):
                            f"S = 1600*({self.response_time:g} + {stopping_time:g} - {self.opening_time:g} opening) "
                            f"+ 850 = {mm(s)} mm (interlocking guard without guard locking)")
 
+    def static_check(self, distance: float, stopping_time: float) -> tuple[float, str]:
+        """This kind's part of the static check (analysis.iso13855 asks any device that has it): the distance
+        stands as measured; the note gives the access time (ISO 14119)."""
+        return distance, self.access_note(distance, stopping_time)
+
     def access_note(self, distance: float, stopping_time: float) -> str:
         """The access time against the time to rest, for a door ``distance`` [m] from the hazard zone: the door
         open wide enough, then a walk at K to within the arm's reach C. ISO 14119:2013 asks for guard locking

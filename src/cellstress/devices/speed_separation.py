@@ -129,6 +129,12 @@ class SpeedSeparation(DeviceRecord):
                 f"{mm(self.c * 1000.0)} + {mm(self.z_d * 1000.0)} + {mm(self.z_r * 1000.0)} = {mm(s * 1000.0)} mm")
         return IsoDistance(v_h * 1000.0, t_r + stopping_time, rest * 1000.0, s * 1000.0, text)
 
+    def static_check(self, distance: float, stopping_time: float) -> tuple[float, str]:
+        """This kind's part of the static check (analysis.iso13855 asks any device that has it): full speed is
+        allowed down to the controller's own S_p, so the separation guaranteed is the lesser of the area's
+        ``distance`` and that (docs/cells.md); the note names the configured times."""
+        return min(distance, self.configured_separation()), self.configured_note(stopping_time)
+
     def configured_note(self, stopping_time: float) -> str:
         """The controller's own S_p at full speed, and which configured time is shorter than the real one."""
         short = [f"{what} {cfg:g} s < real {real:g} s" for what, cfg, real in
