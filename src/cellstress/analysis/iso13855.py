@@ -185,7 +185,7 @@ def lean_reach(layout) -> float:
     best = 0.0
     for f in fwd:
         for lt in lat:
-            K.human_pose(P, 0.0, 0.0, 0.0, float(f), float(lt), W)
+            K.human_pose(P, L.pose_vector(0.0, 0.0, 0.0, float(f), float(lt)), W)
             best = max(best, float(np.hypot(W.sh[:, 0], W.sh[:, 1]).max()))
     return best
 

@@ -39,7 +39,7 @@ def _closest(P, W, ras, rbs, row):
     for k in range(ras.shape[0]):
         d = K.separation(P.cap_r, P.reach, P.scal[L.C_REACH_ORIGIN], P.scal[L.C_REACH_H], P.body[L.B_ARM_LEN],
                          P.fences, W.near, ras[k], rbs[k], W.sh, W.tr, W.ha, W.hb, W.hr, W.lbs, W.ts, W.best_r,
-                         n_near, row)
+                         n_near, row, int(P.body[L.B_N_CAPS]))
         if d < best:
             best, arg = d, k
     return best, arg
@@ -68,7 +68,7 @@ def probe(cell: str = "s2-elbow-intrusion", step: float = 0.05) -> dict:
             for heading_deg in range(0, 360, 30):
                 for f, lat in FLEX:
                     out["poses"] += 1
-                    K.human_pose(P, x, y, math.radians(heading_deg), f * fwd_max, lat * lat_max, W)
+                    K.human_pose(P, L.pose_vector(x, y, math.radians(heading_deg), f * fwd_max, lat * lat_max), W)
                     if not _unseen_and_clear(P, W):
                         continue
                     out["unseen"] += 1

@@ -295,6 +295,7 @@ def _tagged_union(group: str, default: str | None = None):
 
 DEVICE_KINDS: tuple[str, ...] = registry.names("devices")
 CRITERIA: tuple[str, ...] = registry.names("criteria")
+WORKER_MODELS: tuple[str, ...] = registry.names("workers")
 DeviceSpec = _tagged_union("devices")
 CriterionSpec = _tagged_union("criteria", DEFAULT_CRITERION)
 
@@ -330,8 +331,12 @@ class NamedStart(StartSpec):
 
 
 class HumanSpec(Record):
-    """The worker: where they start, their body and how they move (the paper's 30 actions)."""
+    """The worker: where they start, their body and how they move."""
 
+    model: Literal[WORKER_MODELS] = "paper"  # type: ignore[valid-type]
+    """How the worker is modelled (registry group ``workers``). paper: the paper's 30 actions, hanging arms and
+    the reach volumes of the arms (Table III's worker); articulated: jointed arms that collide with fences, the
+    table and obstacles, crouching, kneeling, tiptoe, stepping back and sideways (docs/worker.md)."""
     start: StartSpec
     """The worker's start pose."""
     starts: tuple[NamedStart, ...] = Field((), max_length=MAX_COUNT)

@@ -33,15 +33,16 @@ def simulate(
     Exit code 0 if the episode stays safe, 1 if it ends unsafe, 2 for a bad cell or action."""
     from cellstress.cell.load import load_cell, with_criterion
     from cellstress.core.io import json_ready
-    from cellstress.human.actions import ACTION_NAMES, parse_actions
+    from cellstress.human.actions import parse_actions
     from cellstress.sim.simulator import Simulator
 
-    with user_errors("--actions: "):
-        indices = parse_actions(actions)
     with spinner_while_compiling(), user_errors():
         check_criterion(criterion)
         c = with_criterion(load_cell(cell), criterion)
         sim = Simulator(c)
+    with user_errors("--actions: "):
+        indices = parse_actions(actions, sim.action_index)
+    with spinner_while_compiling(), user_errors():
         trace = sim.run(indices)
     records = [r.model_dump() for r in trace.records()]
     hit = trace.unsafe_row
@@ -56,7 +57,7 @@ def simulate(
             hazard[sim.criterion.type] = verdict.as_dict()
 
     if as_json:
-        doc = {"cell": c.name, "actions": [ACTION_NAMES[i] for i in indices], "steps": records,
+        doc = {"cell": c.name, "actions": [sim.action_names[i] for i in indices], "steps": records,
                "unsafe": hazard is not None, "hazard": hazard}
         say(json.dumps(json_ready(doc), indent=1, allow_nan=False))
         if hazard is not None:

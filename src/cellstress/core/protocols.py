@@ -182,6 +182,22 @@ class Searcher(Protocol):
 
 
 @runtime_checkable
+class WorkerKind(Protocol):
+    """A model of the worker (registry group ``workers``; a cell picks one with ``human.model``): its actions,
+    by name, and the table the compiled simulator moves it by (``human.actions.ACT_COLUMNS``). ``articulated``
+    selects the kernels' pose of the arms: hanging arms with reach volumes (False) or jointed arms (True)."""
+
+    articulated: ClassVar[bool]
+    action_names: tuple[str, ...]
+
+    def action_index(self, action: int | str) -> int: ...
+
+    def action_table(self, max_forward_deg: float, max_lateral_deg: float, stature: float) -> np.ndarray: ...
+
+    def action_words(self, action: str, short: bool = False) -> str: ...
+
+
+@runtime_checkable
 class Device(Protocol):
     """A safety device of a cell (see the module docstring). Upon detection it requests a stop that takes
     effect after ``response_time``."""

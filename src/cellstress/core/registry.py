@@ -1,8 +1,9 @@
 """Plug-in registries through Python entry points, as pytest finds plug-ins and Gymnasium registers envs.
 
-Four groups: ``cellstress.searchers``, ``cellstress.devices``, ``cellstress.criteria`` and
-``cellstress.simulators``. cellstress registers its own plug-ins the same way (``pyproject.toml``), so a third
-party extends it with one module and one line in its own package metadata, without editing cellstress::
+Five groups: ``cellstress.searchers``, ``cellstress.devices``, ``cellstress.criteria``,
+``cellstress.simulators`` and ``cellstress.workers``. cellstress registers its own plug-ins the same way
+(``pyproject.toml``), so a third party extends it with one module and one line in its own package metadata,
+without editing cellstress::
 
     [project.entry-points."cellstress.searchers"]
     my-searcher = "my_package.my_module:MySearcher"
@@ -21,8 +22,9 @@ from importlib.metadata import EntryPoint, entry_points
 
 from cellstress.core.errors import PluginError
 
-GROUPS = ("searchers", "devices", "criteria", "simulators")
-SINGULAR = {"searchers": "searcher", "devices": "device", "criteria": "criterion", "simulators": "simulator"}
+GROUPS = ("searchers", "devices", "criteria", "simulators", "workers")
+SINGULAR = {"searchers": "searcher", "devices": "device", "criteria": "criterion", "simulators": "simulator",
+            "workers": "worker model"}
 OWN_DISTRIBUTION = "cellstress"
 
 

@@ -24,8 +24,18 @@ BODY_PARTS: tuple[str, ...] = (
     "right-arm",
     "left-reach",
     "right-reach",
+    "left-forearm",
+    "right-forearm",
+    "left-hand",
+    "right-hand",
 )
-N_CAPSULES = 6  # the first six parts are capsules; the last two are the reach volumes
+N_CAPSULES = 6  # the paper worker's capsules are the first six parts; the next two are its reach volumes
+# The articulated worker (human.articulated) has ten capsules: the six above (its "arms" are the upper arms),
+# then forearms and hands. Capsule c is body part CAPSULE_PART[c] (the reach volumes sit between).
+MAX_CAPSULES = 10
+CAPSULE_PART: tuple[int, ...] = (0, 1, 2, 3, 4, 5, 8, 9, 10, 11)
+MODEL_PAPER, MODEL_ARTICULATED = 0.0, 1.0  # BODY_PARAMS' MODEL: how the kernels pose the arms
+NO_WALK_BELOW = -0.15  # m: with the hip this far below standing (crouching, kneeling) the worker does not walk
 BODY_RADIUS = 0.20  # m, the footprint that keeps the body centre from fences and table edges
 WALK_BLOCK_HEIGHT = 0.5  # m: a fence panel whose bottom is above this does not stop walking (the worker ducks)
 
@@ -44,11 +54,22 @@ BODY_PARAMS = VectorSpec("body parameters", (
     ("ARM_LEN", "upper arm + forearm + hand [m]: the reach volumes lie within it of the shoulder"),
     ("BODY_RADIUS", "footprint radius kept clear of fences and table edges [m]"),
     ("WALK_SPEED", "walking speed [m/s]"),
+    # the articulated worker (appended, so the slots above never move)
+    ("MODEL", "0: the paper's worker (hanging arms, reach volumes); 1: articulated arms (human.articulated)"),
+    ("N_CAPS", "body capsules the kernels pose, sense and measure: 6 (paper) or 10 (articulated)"),
+    ("UPPER_ARM", "shoulder to elbow [m]"),
+    ("FOREARM", "elbow to wrist [m]"),
+    ("HAND", "wrist to fingertip [m]"),
+    ("R_UPPER", "upper-arm capsule radius of the articulated worker [m]"),
+    ("R_FORE", "forearm capsule radius [m]"),
+    ("R_HAND", "hand capsule radius [m]"),
 ))
 (B_HIP_Z, B_SHOULDER_RISE, B_SHOULDER_HALF, B_LEG_HALF, B_HEAD_RISE, B_TRUNK_TOP, B_R_LEG, B_R_TRUNK, B_R_HEAD,
- B_R_ARM, B_ARM_LEN, B_BODY_RADIUS, B_WALK_SPEED) = BODY_PARAMS.indices(
+ B_R_ARM, B_ARM_LEN, B_BODY_RADIUS, B_WALK_SPEED, B_MODEL, B_N_CAPS, B_UPPER_ARM, B_FOREARM, B_HAND, B_R_UPPER,
+ B_R_FORE, B_R_HAND) = BODY_PARAMS.indices(
     "HIP_Z", "SHOULDER_RISE", "SHOULDER_HALF", "LEG_HALF", "HEAD_RISE", "TRUNK_TOP", "R_LEG", "R_TRUNK", "R_HEAD",
-    "R_ARM", "ARM_LEN", "BODY_RADIUS", "WALK_SPEED")
+    "R_ARM", "ARM_LEN", "BODY_RADIUS", "WALK_SPEED", "MODEL", "N_CAPS", "UPPER_ARM", "FOREARM", "HAND", "R_UPPER",
+    "R_FORE", "R_HAND")
 N_BODY_PARAMS = BODY_PARAMS.size
 
 
@@ -60,6 +81,7 @@ class BodyDimensions:
     hand: float
     walking_speed: float
     body_radius: float = BODY_RADIUS
+    articulated: bool = False
 
     @property
     def arm_length(self) -> float:
@@ -89,20 +111,27 @@ class BodyDimensions:
         p[B_ARM_LEN] = self.arm_length
         p[B_BODY_RADIUS] = self.body_radius
         p[B_WALK_SPEED] = self.walking_speed
+        p[B_MODEL] = MODEL_ARTICULATED if self.articulated else MODEL_PAPER
+        p[B_N_CAPS] = MAX_CAPSULES if self.articulated else N_CAPSULES
+        p[B_UPPER_ARM], p[B_FOREARM], p[B_HAND] = self.upper_arm, self.forearm, self.hand
+        # Round numbers for an adult's limbs in work clothes (as the radii above): the upper arm as the hanging
+        # arm, the forearm between its mid-length and the wrist, the hand about its thickness (docs/worker.md).
+        p[B_R_UPPER], p[B_R_FORE], p[B_R_HAND] = 0.05, 0.04, 0.025
         return p
 
 
 @dataclass(frozen=True, eq=False)
 class BodyPose:
-    """The worker's capsules (``a``-``b`` axis, radius ``r``; order ``BODY_PARTS[:6]``: a[2] is the hip, a[3] the
-    head centre), shoulders (left, right) and trunk frame (columns: forward, left, up) for one pose."""
+    """The worker's capsules (``a``-``b`` axis, radius ``r``; capsule c is body part ``CAPSULE_PART[c]``: a[2] is
+    the hip, a[3] the head centre), shoulders (left, right) and trunk frame (columns: forward, left, up) for one
+    pose: six capsules for the paper's worker, ten for the articulated one."""
 
-    a: np.ndarray  # (6, 3)
-    b: np.ndarray  # (6, 3)
-    r: np.ndarray  # (6,)
+    a: np.ndarray  # (n, 3)
+    b: np.ndarray  # (n, 3)
+    r: np.ndarray  # (n,)
     shoulders: np.ndarray  # (2, 3)
     trunk: np.ndarray  # (3, 3)
 
     @property
     def names(self) -> tuple[str, ...]:
-        return BODY_PARTS[:N_CAPSULES]
+        return tuple(BODY_PARTS[CAPSULE_PART[c]] for c in range(self.r.shape[0]))

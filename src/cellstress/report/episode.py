@@ -15,8 +15,8 @@ from functools import cached_property
 import numpy as np
 
 from cellstress.core.io import json_ready
-from cellstress.human.actions import ACTION_NAMES, action_index
 from cellstress.searchers.result import SearchResult
+from cellstress.sim import layout as L
 from cellstress.sim import scene
 from cellstress.sim.build import Layout
 from cellstress.sim.records import StepRecord
@@ -68,8 +68,9 @@ class EpisodeView:
 
     def pose(self, i: int) -> scene.BodyPose:
         r = self.records[i]
-        return scene.body_pose(self.layout, r.x, r.y, math.radians(r.heading_deg),
-                               math.radians(r.forward_flexion_deg), math.radians(r.lateral_flexion_deg))
+        return scene.body_pose(self.layout, L.pose_vector(
+            r.x, r.y, math.radians(r.heading_deg), math.radians(r.forward_flexion_deg),
+            math.radians(r.lateral_flexion_deg), step_limbs(r)))
 
     def robot(self, i: int) -> tuple[np.ndarray, np.ndarray]:
         return scene.robot_capsules(self.layout, self.taus[i])
@@ -101,6 +102,13 @@ def risk(record: StepRecord) -> float:
     return math.exp(v) / (d * d + 1.0)
 
 
+def step_limbs(record: StepRecord) -> np.ndarray | None:
+    """The articulated worker's drop [m] and arm joints [rad] of a step record (None: the paper's worker)."""
+    if record.limbs is None:
+        return None
+    return np.array([record.limbs[0], *np.deg2rad(record.limbs[1:])])
+
+
 def replay(sim: Simulator, actions, *, episode: int | None = None, kind: str = "hazard",
            recorded: tuple[StepRecord, ...] | None = None) -> EpisodeView:
     """Play ``actions`` from the simulator's start and keep what a report needs. A leading ``start:NAME``
@@ -115,7 +123,7 @@ def replay(sim: Simulator, actions, *, episode: int | None = None, kind: str = "
         matches = _json(records) == _json(recorded)
     # the actions actually played: an unsafe step ends the episode and drops the actions after it
     n_played = -(-(len(records) - 1) // sim.steps_per_action)
-    acts = tuple(ACTION_NAMES[action_index(a)] for a in list(actions)[:n_played])
+    acts = tuple(sim.action_names[sim.action_index(a)] for a in list(actions)[:n_played])
     taus = scene.path_times(trace.rows, len(sim.layout.robots))
     return EpisodeView(sim.layout, sim.start, acts, tuple(records), taus, episode, kind,
                        matches)

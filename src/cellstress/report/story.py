@@ -12,21 +12,13 @@ from cellstress.report.episode import EpisodeView
 from cellstress.searchers.why import touched_robot
 from cellstress.sim.layout import C_PHASE0
 
-_TURNS = {"walk": "walks forward", "turn-left-45": "turns 45° left", "turn-left-90": "turns 90° left",
-          "turn-right-45": "turns 45° right", "turn-right-90": "turns 90° right"}
-_BODIES = {"upright": "stands upright", "bend-forward": "bends forward", "bend-left": "bends to the left",
-           "bend-right": "bends to the right", "bend-forward-left": "bends forward and to the left",
-           "bend-forward-right": "bends forward and to the right"}
 _PARTS = {"left-reach": "within reach of the worker's left hand",
           "right-reach": "within reach of the worker's right hand",
           "left-arm": "touches the worker's left arm", "right-arm": "touches the worker's right arm",
           "left-leg": "touches the worker's left leg", "right-leg": "touches the worker's right leg",
-          "trunk": "touches the worker's trunk", "head": "touches the worker's head"}
-_SHORT_TURNS = {"walk": "walks", "turn-left-45": "turns 45° left", "turn-left-90": "turns 90° left",
-                "turn-right-45": "turns 45° right", "turn-right-90": "turns 90° right"}
-_SHORT_BODIES = {"upright": "upright", "bend-forward": "bending forward", "bend-left": "bending left",
-                 "bend-right": "bending right", "bend-forward-left": "bending forward-left",
-                 "bend-forward-right": "bending forward-right"}
+          "trunk": "touches the worker's trunk", "head": "touches the worker's head",
+          "left-forearm": "touches the worker's left forearm", "right-forearm": "touches the worker's right forearm",
+          "left-hand": "touches the worker's left hand", "right-hand": "touches the worker's right hand"}
 _PHASES = {"running": "no stop has been requested, the robot runs at full speed",
            "stop-pending": "a stop has been requested but has not taken effect yet",
            "braking": "the robot is braking but has not stopped",
@@ -41,11 +33,6 @@ def link_words(name: str | None) -> str:
     base, _, extra = name.partition("#")
     words = base.removesuffix("_link").replace("_", " ")
     return f"part held on {base} ({name})" if extra else f"{words} ({name})"
-
-
-def action_words(action: str) -> str:
-    walk, _, body = action.partition("+")
-    return f"{_TURNS.get(walk, walk)} and {_BODIES.get(body, body)}"
 
 
 def _xy(r: dict) -> str:
@@ -98,7 +85,7 @@ def account(view: EpisodeView, episodes: int | None = None) -> Account:
         walk = act.partition("+")[0]
         where = f"to {_xy(last)}" if moved > 0.005 else "in place"
         blocked = " (blocked: does not move)" if walk == "walk" and moved <= 0.005 else ""
-        details.append(f"Action {k + 1} ({first.t:.2f}-{last.t:.2f} s): {action_words(act)}, {where}"
+        details.append(f"Action {k + 1} ({first.t:.2f}-{last.t:.2f} s): {view.layout.worker.action_words(act)}, {where}"
                        f"{blocked}; heading {last.heading_deg:.0f}°, bent {last.forward_flexion_deg:.0f}° "
                        f"forward and {abs(last.lateral_flexion_deg):.0f}° to the "
                        f"{'left' if last.lateral_flexion_deg >= 0 else 'right'}.")
@@ -132,8 +119,7 @@ def account(view: EpisodeView, episodes: int | None = None) -> Account:
                       f"t = {stop[0] + touched_robot(view.layout, hit).spec.stopping_time:.2f} s")
     else:
         phase_text = _PHASES.get(phase, phase)
-    moves = ", ".join(f"{_SHORT_TURNS.get(w, w)} {_SHORT_BODIES.get(b, b)}"
-                      for w, _, b in (a.partition("+") for a in view.actions))
+    moves = ", ".join(view.layout.worker.action_words(a, short=True) for a in view.actions)
     if view.unsafe:
         details.append(f"At t = {hit.t:.2f} s (step {hit.step}) the robot's {link} is "
                        f"{_PARTS.get(part, part)} at ({px:.2f}, {py:.2f}, {pz:.2f}) m, while the robot moves at "

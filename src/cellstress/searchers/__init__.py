@@ -14,7 +14,6 @@ from pathlib import Path
 from cellstress.core import registry
 from cellstress.core.errors import PluginError
 from cellstress.core.version import __version__
-from cellstress.human.actions import ACTION_NAMES
 from cellstress.searchers.common import (
     UNTIL,
     Episode,
@@ -152,7 +151,7 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
 
     if names is None:
         def names(actions):
-            return [ACTION_NAMES[a] for a in actions]
+            return [sim.action_names[a] for a in actions]
 
     first = out.first_hazard
     hazard = None if first is None else hazard_record(sim, first.index, names(first.actions))

@@ -32,7 +32,7 @@ from cellstress.core.records import Measures
 from cellstress.human.regions import body_region, region_group
 from cellstress.searchers.common import Recorder, Stop
 from cellstress.searchers.result import HazardClass
-from cellstress.sim.layout import M_FWD, M_HEADING, M_HX, M_HZ, M_LAT, M_LINK, M_PART, M_TAU, M_X, M_Y, S_TRIG_DEV
+from cellstress.sim.layout import M_HX, M_HZ, M_LINK, M_PART, M_TAU, M_X, M_Y, S_TRIG_DEV, row_pose
 from cellstress.sim.scene import body_pose
 
 CELL_SIZE = 0.5
@@ -44,7 +44,7 @@ def hazard_class(sim, state, row) -> tuple:
     dev = int(state[S_TRIG_DEV])
     device = lay.device_names[dev] if dev >= 0 else "none"
     link = lay.capsules[int(row[M_LINK])].name
-    pose = body_pose(lay, row[M_X], row[M_Y], row[M_HEADING], row[M_FWD], row[M_LAT])
+    pose = body_pose(lay, row_pose(row))
     b = lay.body
     region = body_region(int(row[M_PART]), row[M_HX:M_HZ + 1], pose, b.height, b.upper_arm, b.forearm)
     key = (device, link, region, math.floor(row[M_X] / CELL_SIZE), math.floor(row[M_Y] / CELL_SIZE))

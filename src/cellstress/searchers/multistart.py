@@ -14,7 +14,6 @@ episode. The tree searchers widen the root over the C choices only (``choices``:
 
 from __future__ import annotations
 
-from cellstress.human.actions import ACTION_NAMES
 from cellstress.sim.starts import START_PREFIX, arrival_phases, phase_token, start_simulator
 
 
@@ -93,7 +92,7 @@ class ArrivalProblem:
         head = [START_PREFIX + self.starts[i].name] if self.starts else []
         if self.searched_phase:
             head.append(phase_token(phase))
-        return [*head, *(ACTION_NAMES[int(a)] for a in acts[1:])]
+        return [*head, *(self.sim.action_names[int(a)] for a in acts[1:])]
 
 
 MultiStartProblem = ArrivalProblem  # its name before the arrival phase was searched

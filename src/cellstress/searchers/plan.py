@@ -184,7 +184,9 @@ class _Model:
         self.offsets = np.asarray([sim.phase_step(c) for c in range(sim.choices(0))] if lead else [0], dtype=np.int64)
         n_path = int(self.offsets.max()) + self.n_steps + 1
         self.v_tol = float(sim.params.scal[L.C_VTOL])
-        self.pose_cols = [L.M_X, L.M_Y, L.M_HEADING, L.M_FWD, L.M_LAT]
+        self.pose_cols = list(L.POSE_ROW)
+        # the articulated worker's stance and arms tell apart poses that devices see differently
+        self.limb_features = float(sim.params.body[L.B_MODEL]) != 0.0
         # per robot (a cell of several robots: each has its own path, speed and stop)
         self.n_robots = 1 + int(sim.params.x_scal.shape[0])
         # path step -> {cell: (point, offset)}
@@ -200,8 +202,11 @@ class _Model:
 
     def _features(self, poses: np.ndarray) -> np.ndarray:
         wx, wy, wh, wf = POSE_WEIGHTS
-        return np.column_stack([wx * poses[:, 0], wy * poses[:, 1], wh * np.cos(poses[:, 2]),
-                                wh * np.sin(poses[:, 2]), wf * poses[:, 3], wf * poses[:, 4]])
+        cols = [wx * poses[:, 0], wy * poses[:, 1], wh * np.cos(poses[:, 2]), wh * np.sin(poses[:, 2]),
+                wf * poses[:, 3], wf * poses[:, 4]]
+        if self.limb_features:  # (the drop in metres weighs as x and y; the joints as the trunk's angles)
+            cols += [wx * poses[:, L.POSE_EXT], *(wf * poses[:, j] for j in range(L.POSE_EXT + 1, L.N_POSE))]
+        return np.column_stack(cols)
 
     def owner_phase(self, rows: np.ndarray) -> np.ndarray:
         """The stop phase, in each row, of the robot that owns the row's nearest point (robot 0's: one robot)."""
@@ -282,7 +287,7 @@ class _Model:
         if self._tree is None:
             self._tree = (cKDTree(np.concatenate(self.feats)), np.concatenate(self.seen))
         tree, seen_at = self._tree
-        poses = self.sim.worker_paths(seqs[:, self.lead:]).reshape(-1, 5)
+        poses = self.sim.worker_paths(seqs[:, self.lead:]).reshape(-1, L.N_POSE)
         seen = seen_at[tree.query(self._features(poses))[1]].reshape(n, steps)
         known = np.zeros(n, dtype=np.int64)
         played_brake = np.full((self.n_robots, n), -1)

@@ -10,11 +10,12 @@ import numpy as np
 from cellstress.cell.load import Cell
 from cellstress.cell.program import held_joints, robot_program
 from cellstress.cell.schema import ObstacleSpec, RobotSpec
+from cellstress.core import registry
 from cellstress.core.errors import CellError
-from cellstress.core.protocols import Channels, TimedPanels
+from cellstress.core.protocols import Channels, TimedPanels, WorkerKind
 from cellstress.core.records import MAX_DOORS, Channel, DoorLeaf, ScanPlane, VerticalField
 from cellstress.devices.base import stops_of
-from cellstress.human.actions import action_table
+from cellstress.human.actions import PaperWorker
 from cellstress.human.body import BodyDimensions
 from cellstress.human.reach import ReachField, reach_field
 from cellstress.robot.capsules import Capsule, base_footprint, declared_capsule, fitted_capsules
@@ -131,6 +132,7 @@ class Layout:
     joints: JointMap  # the joints the program drives; the others are held or mimic ones
     obstacles: tuple[ObstacleSpec, ...] = ()  # the table's polygons, the cell's obstacles, the robots' pedestals
     robots: tuple[RobotPart, ...] = ()  # every robot, robot 0 (robot, capsules' first, trajectory, joints) first
+    worker: WorkerKind = PaperWorker()  # the worker model (registry group ``workers``): its actions by name
 
     @property
     def static_fences(self) -> bool:
@@ -228,7 +230,9 @@ def build_layout(cell: Cell) -> Layout:
     robot, traj, task = part0.model, part0.trajectory, spec.robot.task
     caps = [c for p in parts for c in p.capsules]
     anth = spec.human.anthropometry
-    body = BodyDimensions(anth.height, anth.upper_arm, anth.forearm, anth.hand, spec.human.walking_speed)
+    worker = registry.load("workers", spec.human.model)()
+    body = BodyDimensions(anth.height, anth.upper_arm, anth.forearm, anth.hand, spec.human.walking_speed,
+                          articulated=worker.articulated)
     reach = reach_field(anth.upper_arm, anth.forearm, anth.hand)
 
     fences = [(a[0], a[1], b[0], b[1], f.bottom, f.top)
@@ -268,7 +272,8 @@ def build_layout(cell: Cell) -> Layout:
     params = K.SimParams(
         scal=scal,
         spa=int(spec.simulation.steps_per_action),
-        act=action_table(spec.human.max_forward_flexion_deg, spec.human.max_lateral_flexion_deg),
+        act=np.ascontiguousarray(worker.action_table(spec.human.max_forward_flexion_deg,
+                                                     spec.human.max_lateral_flexion_deg, anth.height)),
         body=body.params(),
         base=base_matrix(spec.robot.base.xyz, spec.robot.base.yaw_deg),
         parents=robot.parents.astype(np.int64),
@@ -317,7 +322,7 @@ def build_layout(cell: Cell) -> Layout:
     )
     params = _with_robot_table(params, spec)
     return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params, part0.joints, obstacles,
-                  tuple(parts))
+                  tuple(parts), worker)
 
 
 def _joint_kinds(robot: RobotModel) -> np.ndarray:

@@ -49,7 +49,7 @@ class ContactModel:
         link, part = int(row[L.M_LINK]), int(row[L.M_PART])
         rp = np.array(row[L.M_RX:L.M_RZ + 1], dtype=float)
         hp = np.array(row[L.M_HX:L.M_HZ + 1], dtype=float)
-        pose = scene.body_pose(lay, row[L.M_X], row[L.M_Y], row[L.M_HEADING], row[L.M_FWD], row[L.M_LAT])
+        pose = scene.body_pose(lay, L.row_pose(row))
         q, qd = scene.joint_state(lay, row)
         n = scene.contact_normal(lay, row, pose)
         b = lay.body

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from cellstress.human.actions import action_index
 from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
 
@@ -25,7 +24,7 @@ def _same_bits(a: np.ndarray, b: np.ndarray) -> bool:
 
 def check_determinism(sim: Simulator, sequences, repeats: int = 2) -> int:
     """Raise DeterminismError at the first disagreement; return the number of episodes checked."""
-    seqs = [[action_index(a) for a in seq] for seq in sequences]
+    seqs = [[sim.action_index(a) for a in seq] for seq in sequences]
     for n, seq in enumerate(seqs):
         ref = sim.run(seq).rows
         for _ in range(repeats - 1):

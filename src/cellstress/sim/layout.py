@@ -10,30 +10,59 @@ kernels, so where a slot lives is decided in this file alone.
 
 from __future__ import annotations
 
+import numpy as np
+
 from cellstress.core.records import MAX_DOORS
 from cellstress.core.vector_spec import VectorSpec
+from cellstress.human.actions import (  # noqa: F401  (re-exported: the action table's columns)
+    A_DIR,
+    A_DROP,
+    A_FWD,
+    A_HANG,
+    A_LAT,
+    A_Q0,
+    A_SET_ARMS,
+    A_SET_STANCE,
+    A_SET_TRUNK,
+    A_TURN,
+    A_WALK,
+    ACT_COLUMNS,
+    N_ACT_COLUMNS,
+)
 from cellstress.human.body import (  # noqa: F401  (re-exported: the kernels and their callers read them here)
     B_ARM_LEN,
     B_BODY_RADIUS,
+    B_FOREARM,
+    B_HAND,
     B_HEAD_RISE,
     B_HIP_Z,
     B_LEG_HALF,
+    B_MODEL,
+    B_N_CAPS,
     B_R_ARM,
+    B_R_FORE,
+    B_R_HAND,
     B_R_HEAD,
     B_R_LEG,
     B_R_TRUNK,
+    B_R_UPPER,
     B_SHOULDER_HALF,
     B_SHOULDER_RISE,
     B_TRUNK_TOP,
+    B_UPPER_ARM,
     B_WALK_SPEED,
     BODY_PARAMS,
     BODY_PARTS,
+    CAPSULE_PART,
+    MAX_CAPSULES,
     N_BODY_PARAMS,
     N_CAPSULES,
+    NO_WALK_BELOW,
 )
 
 SEP_QUEUE = 16  # speed commands in flight at most: a separation channel's response time is below 16 time steps
 _SEP_SLOTS = tuple(f"SEP_Q{i}" for i in range(1, SEP_QUEUE))  # (the kernels index them as S_SEP_Q0 + i)
+_ARM_SLOTS = tuple(f"ARM{k}_Q{j}" for k in range(2) for j in range(5))
 _DOOR_SLOTS = tuple(f"DOOR{i}_{what}" for what in ("REQ", "OPEN") for i in range(MAX_DOORS))
 
 STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
@@ -80,17 +109,23 @@ STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
     ("SEP_LOW", "the lowest fraction commanded so far (1: none below full speed)"),
     ("SEP_LOW_T", "time of the measurement that commanded SEP_LOW [s]; -1: none"),
     ("SEP_LOW_S", "the separation measured then [m]; -1: none"),
+    # the articulated worker (issue 20; appended): its stance and arm joints (0 for the paper's worker)
+    ("DROP", "the hip's height above its standing height [m]: negative crouching or kneeling, positive on tiptoe"),
+    *((f"ARM{k}_Q{j}", f"{side} arm's joint {j} [rad] (human.reach's order: shoulder flexion, abduction, upper-arm "
+                       "rotation, elbow flexion, wrist flexion), relative to the trunk")
+      for k, side in enumerate(("left", "right")) for j in range(5)),
 ))
 (S_K, S_X, S_Y, S_HEADING, S_FWD, S_LAT, S_TSTOP, S_TRIG_DEV, S_TRIG_T, S_UNSAFE, S_ACTIONS, S_LIVE, S_A_T, S_A_TAU,
  S_A_SIG, S_A_TGT, S_TSLOW, S_SLOW, S_STOP_SEEN, S_STOP_CLEAR, S_SLOW_SEEN, S_SLOW_CLEAR, S_RESTARTS,
  S_DOOR0_REQ, S_DOOR1_REQ, S_DOOR2_REQ, S_DOOR3_REQ, S_DOOR0_OPEN, S_DOOR1_OPEN, S_DOOR2_OPEN,
  S_DOOR3_OPEN, S_XTSTOP1, S_XTSTOP2, S_XTSTOP3, S_SEP_ON, S_SEP_Q0, S_SEP_Q1, S_SEP_Q2, S_SEP_Q3, S_SEP_Q4,
  S_SEP_Q5, S_SEP_Q6, S_SEP_Q7, S_SEP_Q8, S_SEP_Q9, S_SEP_Q10, S_SEP_Q11, S_SEP_Q12, S_SEP_Q13, S_SEP_Q14, S_SEP_Q15,
- S_SEP_LOW, S_SEP_LOW_T, S_SEP_LOW_S) = STATE.indices(
+ S_SEP_LOW, S_SEP_LOW_T, S_SEP_LOW_S, S_DROP, *_S_ARMS) = STATE.indices(
     "K", "X", "Y", "HEADING", "FWD", "LAT", "TSTOP", "TRIG_DEV", "TRIG_T", "UNSAFE", "ACTIONS", "LIVE", "A_T", "A_TAU",
     "A_SIG", "A_TGT", "TSLOW", "SLOW", "STOP_SEEN", "STOP_CLEAR", "SLOW_SEEN", "SLOW_CLEAR", "RESTARTS",
     *_DOOR_SLOTS, "XTSTOP1", "XTSTOP2", "XTSTOP3", "SEP_ON", "SEP_Q0", *_SEP_SLOTS, "SEP_LOW",
-    "SEP_LOW_T", "SEP_LOW_S")
+    "SEP_LOW_T", "SEP_LOW_S", "DROP", *_ARM_SLOTS)
+S_ARM = _S_ARMS[0]  # arm k's joint j: S_ARM + 5 k + j
 S_DOOR_REQ, S_DOOR_OPEN = S_DOOR0_REQ, S_DOOR0_OPEN  # door i's slots: these + i (the kernels index by door)
 NS = STATE.size
 S_XTSTOP = S_XTSTOP1  # robot r >= 1's stop is S_XTSTOP + r - 1 (the kernels loop over them)
@@ -127,12 +162,39 @@ ROW = VectorSpec("metric row (one per time step; row 0 of an episode is its star
     ("XPHASE1", "robot 1's stop phase (PHASE); -1: no such robot"),
     ("XPHASE2", "robot 2's stop phase"),
     ("XPHASE3", "robot 3's stop phase"),
+    # the articulated worker (appended): the pose beyond X..LAT, as the state's DROP and ARMk_Qj
+    ("DROP", "the hip's height above standing [m] (state DROP)"),
+    *((f"ARM{k}_Q{j}", f"arm {k}'s joint {j} [rad] (state ARM{k}_Q{j})") for k in range(2) for j in range(5)),
 ))
 (M_T, M_X, M_Y, M_HEADING, M_FWD, M_LAT, M_D, M_V, M_SEEN, M_PHASE, M_LINK, M_PART, M_RX, M_RY, M_RZ, M_HX, M_HY, M_HZ,
- M_UNSAFE, M_TAU, M_ACTION, M_STEP, M_ROBOT, M_XTAU1, M_XTAU2, M_XTAU3, M_XPHASE1, M_XPHASE2, M_XPHASE3) = ROW.indices(
+ M_UNSAFE, M_TAU, M_ACTION, M_STEP, M_ROBOT, M_XTAU1, M_XTAU2, M_XTAU3, M_XPHASE1, M_XPHASE2, M_XPHASE3, M_DROP,
+ *_M_ARMS) = ROW.indices(
     "T", "X", "Y", "HEADING", "FWD", "LAT", "D", "V", "SEEN", "PHASE", "LINK", "PART", "RX", "RY", "RZ", "HX", "HY",
-    "HZ", "UNSAFE", "TAU", "ACTION", "STEP", "ROBOT", "XTAU1", "XTAU2", "XTAU3", "XPHASE1", "XPHASE2", "XPHASE3")
+    "HZ", "UNSAFE", "TAU", "ACTION", "STEP", "ROBOT", "XTAU1", "XTAU2", "XTAU3", "XPHASE1", "XPHASE2", "XPHASE3",
+    "DROP", *_ARM_SLOTS)
+M_ARM = _M_ARMS[0]
 NM = ROW.size
+# A worker's pose as a vector (Simulator.worker_paths, worker_distances, scene.body_pose): x, y, heading, forward
+# and lateral flexion, then DROP and the ten arm joints; where a state and a row keep it.
+N_POSE = 16
+POSE_STATE = (S_X, S_Y, S_HEADING, S_FWD, S_LAT, *range(S_DROP, S_DROP + 11))
+POSE_ROW = (M_X, M_Y, M_HEADING, M_FWD, M_LAT, *range(M_DROP, M_DROP + 11))
+POSE_EXT = 5  # where DROP is in a pose vector (the kernels read DROP and the joints from there on)
+
+
+def row_pose(row) -> np.ndarray:
+    """The worker's pose vector (POSE_ROW) of a metric row."""
+    return np.asarray(row, dtype=float)[list(POSE_ROW)]
+
+
+def pose_vector(x: float, y: float, heading: float, forward: float = 0.0, lateral: float = 0.0,
+                limbs=None) -> np.ndarray:
+    """A pose vector from its parts (``limbs``: the articulated worker's drop and ten arm joints; absent: 0)."""
+    pose = np.zeros(N_POSE)
+    pose[:5] = x, y, heading, forward, lateral
+    if limbs is not None:
+        pose[POSE_EXT:] = limbs
+    return pose
 M_XTAU, M_XPHASE = M_XTAU1, M_XPHASE1  # robot r >= 1's path time and stop phase: + r - 1
 
 PHASE = VectorSpec("robot stop phase (values of the row's PHASE; records.STOP_PHASES names them in files)", (
@@ -177,6 +239,7 @@ JOINT_KINDS = VectorSpec("robot joint kinds (SimParams.jtype)", (
 ))
 JOINT_REVOLUTE, JOINT_PRISMATIC = JOINT_KINDS.indices("REVOLUTE", "PRISMATIC")
 
-# The worker's parts in the row's PART: the body capsules, then the two reach volumes.
+# The worker's parts in the row's PART: the paper worker's six capsules, its two reach volumes, then the
+# articulated worker's forearms and hands (capsule c is part CAPSULE_PART[c]). Work holds MAX_CAPSULES.
 N_BODY_CAPSULES = N_CAPSULES
 PART_LEFT_REACH, PART_RIGHT_REACH = BODY_PARTS.index("left-reach"), BODY_PARTS.index("right-reach")

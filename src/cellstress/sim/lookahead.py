@@ -55,11 +55,15 @@ def lookahead_gaps(P, W, rows, t_stop, horizon, speed, n_tau, out):
     arm_len = P.body[L.B_ARM_LEN]
     origin, grid_h = scal[L.C_REACH_ORIGIN], scal[L.C_REACH_H]
     scratch = np.zeros(L.NM)
+    pose = np.zeros(L.N_POSE)
     for i in range(rows.shape[0]):
         t0 = rows[i, L.M_T]
         ts = np.inf if rows[i, L.M_PHASE] == L.PHASE_RUNNING else t_stop
-        K.human_pose(P, rows[i, L.M_X], rows[i, L.M_Y], rows[i, L.M_HEADING], rows[i, L.M_FWD], rows[i, L.M_LAT],
-                     W)
+        for k in range(5):
+            pose[k] = rows[i, L.M_X + k]
+        for k in range(11):
+            pose[L.POSE_EXT + k] = rows[i, L.M_DROP + k]
+        K.human_pose(P, pose, W)
         n_near = K.near_fences(P, W, arm_len + 0.05)  # as sense_and_measure collects them
         best = np.inf
         for j in range(n_tau + 1):
@@ -68,7 +72,7 @@ def lookahead_gaps(P, W, rows, t_stop, horizon, speed, n_tau, out):
             if not v > vtol:
                 continue
             d = K.separation(P.cap_r, P.reach, origin, grid_h, arm_len, P.fences, W.near, W.ra, W.rb, W.sh, W.tr,
-                             W.ha, W.hb, W.hr, W.lbs, W.ts, W.best_r, n_near, scratch)
+                             W.ha, W.hb, W.hr, W.lbs, W.ts, W.best_r, n_near, scratch, L.N_BODY_CAPSULES)
             g = (d if d > 0.0 else 0.0) - speed * tau
             if g < best:
                 best = g

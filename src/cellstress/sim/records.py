@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import Field
+from pydantic import Field, model_serializer
 
 from cellstress.core.fields import Record
 
@@ -38,3 +38,14 @@ class StepRecord(Record):
     robot_point: Coordinate
     human_point: Coordinate
     unsafe: bool
+    limbs: Annotated[tuple[float, ...], Field(min_length=11, max_length=11)] | None = None
+    """The articulated worker's hip drop [m] and arm joints [deg] (left arm's five, then the right's, in
+    human.reach's order); absent for the paper's worker."""
+
+    @model_serializer(mode="wrap")
+    def _without_absent_limbs(self, handler):
+        # (the paper worker's records stay as they were: no "limbs": null in every step of a result file)
+        doc = handler(self)
+        if isinstance(doc, dict) and doc.get("limbs") is None:
+            doc.pop("limbs", None)
+        return doc

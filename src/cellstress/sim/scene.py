@@ -10,18 +10,20 @@ from __future__ import annotations
 import numpy as np
 
 from cellstress.core.jit import njit
-from cellstress.human.body import N_CAPSULES, BodyPose
+from cellstress.human.body import CAPSULE_PART, BodyPose
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 from cellstress.sim.build import Layout
 from cellstress.sim.geometry import segment_segment
 
 
-def body_pose(layout: Layout, x: float, y: float, heading: float, forward: float, lateral: float) -> BodyPose:
-    """Body capsules for a position [m] and heading / forward / lateral flexion [rad] (``kernels.human_pose``)."""
+def body_pose(layout: Layout, pose: np.ndarray) -> BodyPose:
+    """Body capsules for a pose vector (``layout.POSE_ROW``'s order; ``layout.row_pose``, ``layout.pose_vector``)
+    as ``kernels.human_pose`` places them."""
     W = K.make_work(layout.params)
-    K.human_pose(layout.params, float(x), float(y), float(heading), float(forward), float(lateral), W)
-    return BodyPose(W.ha.copy(), W.hb.copy(), W.hr.copy(), W.sh.copy(), W.tr.copy())
+    K.human_pose(layout.params, np.ascontiguousarray(pose, dtype=float), W)
+    n = int(layout.params.body[L.B_N_CAPS])
+    return BodyPose(W.ha[:n].copy(), W.hb[:n].copy(), W.hr[:n].copy(), W.sh.copy(), W.tr.copy())
 
 
 def robot_capsules(layout: Layout, tau) -> tuple[np.ndarray, np.ndarray]:
@@ -118,13 +120,14 @@ def contact_normal(layout: Layout, row: np.ndarray, pose: BodyPose) -> np.ndarra
     (as the kernel places the points)."""
     part, link = int(row[L.M_PART]), int(row[L.M_LINK])
     rp = np.asarray(row[L.M_RX:L.M_RZ + 1], dtype=float)
-    if part >= N_CAPSULES:
-        v = pose.shoulders[part - N_CAPSULES] - rp
+    if part in (L.PART_LEFT_REACH, L.PART_RIGHT_REACH):
+        v = pose.shoulders[part - L.PART_LEFT_REACH] - rp
     else:
+        c = CAPSULE_PART.index(part)
         ra, rb = robot_capsules(layout, float(row[L.M_TAU]))
         c1, c2 = np.zeros(3), np.zeros(3)
         segment_segment(np.ascontiguousarray(ra[link]), np.ascontiguousarray(rb[link]),
-                          np.ascontiguousarray(pose.a[part]), np.ascontiguousarray(pose.b[part]), c1, c2)
+                          np.ascontiguousarray(pose.a[c]), np.ascontiguousarray(pose.b[c]), c1, c2)
         v = c2 - c1
         if float(np.linalg.norm(v)) <= 1e-9:
             v = np.asarray(row[L.M_HX:L.M_HZ + 1], dtype=float) - rp

@@ -19,7 +19,6 @@ import numpy as np
 
 from cellstress.cell.load import Cell, load_cell
 from cellstress.core.records import Measures
-from cellstress.human.actions import ACTION_NAMES, N_ACTIONS, action_index
 from cellstress.human.body import BODY_PARTS
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
@@ -63,7 +62,7 @@ def step_record(row: np.ndarray, layout: Layout) -> StepRecord:
     return StepRecord.model_construct(
         step=int(row[L.M_STEP]),
         t=round(float(row[L.M_T]), 9),  # k * dt carries float noise (0.6000000000000001)
-        action=ACTION_NAMES[act] if act >= 0 else None,
+        action=layout.worker.action_names[act] if act >= 0 else None,
         x=float(row[L.M_X]),
         y=float(row[L.M_Y]),
         heading_deg=float(np.rad2deg(row[L.M_HEADING])),
@@ -79,7 +78,13 @@ def step_record(row: np.ndarray, layout: Layout) -> StepRecord:
         robot_point=tuple(float(v) for v in row[L.M_RX:L.M_RZ + 1]),
         human_point=tuple(float(v) for v in row[L.M_HX:L.M_HZ + 1]),
         unsafe=bool(row[L.M_UNSAFE]),
+        limbs=limbs_record(row) if layout.worker.articulated else None,
     )
+
+
+def limbs_record(row: np.ndarray) -> tuple[float, ...]:
+    """The articulated worker's drop [m] and arm joints [deg] of a metric row, as StepRecord.limbs keeps them."""
+    return (float(row[L.M_DROP]), *(float(np.rad2deg(row[L.M_ARM + j])) for j in range(10)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -157,7 +162,16 @@ class Simulator:
 
     @property
     def n_actions(self) -> int:
-        return N_ACTIONS
+        return len(self.layout.worker.action_names)
+
+    @property
+    def action_names(self) -> tuple[str, ...]:
+        """The worker model's actions, in index order."""
+        return self.layout.worker.action_names
+
+    def action_index(self, action: int | str) -> int:
+        """The index of an action of this cell's worker given by name or index (ActionError otherwise)."""
+        return self.layout.worker.action_index(action)
 
     @property
     def steps_per_action(self) -> int:
@@ -181,7 +195,7 @@ class Simulator:
 
     def step(self, state: np.ndarray, action: int | str) -> tuple[np.ndarray, np.ndarray]:
         """Play one action from ``state``: (next state, metric rows of its time steps)."""
-        a = action if type(action) is int and 0 <= action < N_ACTIONS else action_index(action)
+        a = action if type(action) is int and 0 <= action < self.n_actions else self.action_index(action)
         nxt = state.copy()
         n = K.step_with_handle(self._handle, nxt, a, self._rows)
         rows = self._rows[:n].copy()
@@ -268,7 +282,7 @@ class Simulator:
         if len(actions) and is_arrival_token(actions[0]):
             sim, rest = split_start(self, actions)
             return sim.run(rest)
-        acts = np.asarray([action_index(a) for a in actions], dtype=np.int64)
+        acts = np.asarray([self.action_index(a) for a in actions], dtype=np.int64)
         if self.contacts is not None:  # step by step, so that the criterion ends the episode
             state, parts = self.reset(), [self._row0[None, :].copy()]
             for a in acts:
@@ -283,7 +297,7 @@ class Simulator:
 
     def run_batch(self, actions: np.ndarray) -> BatchResult:
         """Many episodes at once on all cores; ``actions`` is (episodes, actions) of action indices."""
-        acts = _action_array(actions)
+        acts = _action_array(actions, self.n_actions)
         n_ep, n_act = acts.shape
         d_end = np.empty((n_ep, n_act))
         v_end = np.empty((n_ep, n_act))
@@ -315,25 +329,28 @@ class Simulator:
         return BatchResult(d_end, v_end, unsafe_step, min_d, self.params.spa, severity)
 
     def worker_paths(self, actions: np.ndarray) -> np.ndarray:
-        """The worker's poses (x, y, heading [rad], forward and lateral flexion [rad]) at every 50 ms step of
-        each episode of ``actions`` (episodes, actions), as if no contact ended it: (episodes, actions * spa, 5).
+        """The worker's pose vectors (``layout.POSE_ROW``'s order: x, y, heading [rad], forward and lateral
+        flexion [rad], the articulated worker's drop and arm joints) at every 50 ms step of each episode of
+        ``actions`` (episodes, actions), as if no contact ended it: (episodes, actions * spa, N_POSE).
 
         The worker's motion depends on the actions and the fixed layout (walls, table, floor) only, never on
         the robot or the devices, so this is exact and plays no episode: the rows of ``run`` hold the same poses
         up to the step where the episode ended."""
-        acts = _action_array(actions)
-        out = np.empty((acts.shape[0], acts.shape[1] * self.params.spa, 5))
+        acts = _action_array(actions, self.n_actions)
+        out = np.empty((acts.shape[0], acts.shape[1] * self.params.spa, L.N_POSE))
         K.worker_paths(self.params, self._s0, acts, self._worker_work(), out)
         return out
 
     def worker_distances(self, poses: np.ndarray, points: np.ndarray) -> np.ndarray:
-        """Distance from the worker at each of ``poses`` (n, 5: x, y, heading, forward and lateral flexion, as in
-        the metric rows) to each of its ``points`` (n, m, 3; NaN rows are skipped and give inf): the worker's
-        side of d_HR (reach volumes around the walls, body capsules), without the robot. (n, m)."""
+        """Distance from the worker at each of ``poses`` (n, N_POSE pose vectors, as ``worker_paths`` gives them
+        and ``layout.row_pose`` reads them from metric rows) to each of its ``points`` (n, m, 3; NaN rows are
+        skipped and give inf): the paper worker's side of d_HR (reach volumes around the walls, body capsules),
+        without the robot; for the articulated worker, its reach volumes are the conservative envelope. (n, m)."""
         poses = np.ascontiguousarray(poses, dtype=np.float64)
         points = np.ascontiguousarray(points, dtype=np.float64)
-        if poses.ndim != 2 or poses.shape[1] != 5 or points.ndim != 3 or points.shape[::2] != (len(poses), 3):
-            raise ValueError("poses must be (n, 5) and points (n, m, 3)")
+        if poses.ndim != 2 or poses.shape[1] != L.N_POSE or points.ndim != 3 or \
+                points.shape[::2] != (len(poses), 3):
+            raise ValueError(f"poses must be (n, {L.N_POSE}) and points (n, m, 3)")
         out = np.empty(points.shape[:2])
         K.worker_point_distances(self.params, self._worker_work(), poses, points, out)
         return out
@@ -346,11 +363,11 @@ class Simulator:
         return self._worker_w
 
 
-def _action_array(actions) -> np.ndarray:
+def _action_array(actions, n_actions: int) -> np.ndarray:
     """``actions`` as a contiguous (episodes, actions) int64 array; ValueError for anything else."""
     acts = np.ascontiguousarray(actions, dtype=np.int64)
-    if acts.ndim != 2 or acts.size and (acts.min() < 0 or acts.max() >= N_ACTIONS):
-        raise ValueError(f"actions must be a 2-D array of indices in 0..{N_ACTIONS - 1}")
+    if acts.ndim != 2 or acts.size and (acts.min() < 0 or acts.max() >= n_actions):
+        raise ValueError(f"actions must be a 2-D array of indices in 0..{n_actions - 1}")
     return acts
 
 
@@ -365,5 +382,6 @@ def _state_at(nxt: np.ndarray, before: np.ndarray, rows: np.ndarray, params) -> 
     nxt[L.S_FWD], nxt[L.S_LAT] = row[L.M_FWD], row[L.M_LAT]
     nxt[L.S_TSTOP], nxt[L.S_TRIG_DEV], nxt[L.S_TRIG_T] = before[L.S_TSTOP], before[L.S_TRIG_DEV], before[L.S_TRIG_T]
     nxt[L.S_LIVE:] = before[L.S_LIVE:]  # the safeguard slots, appended after ACTIONS
+    nxt[L.S_DROP:L.S_DROP + 11] = row[L.M_DROP:L.M_DROP + 11]  # the articulated worker's stance and arms
     for r in rows:
         K.latch_seen(params, nxt, np.int64(r[L.M_SEEN]), float(r[L.M_T]))

@@ -1,4 +1,5 @@
-"""The worker's body capsules, shoulders and trunk frame for a position, heading and trunk flexion."""
+"""The worker's body capsules, shoulders and trunk frame for a pose: position, heading, trunk flexion, and for
+the articulated worker its stance (the hip's drop) and the joints of both arms."""
 
 from __future__ import annotations
 
@@ -7,28 +8,38 @@ import numpy as np
 from cellstress.core.jit import njit
 from cellstress.sim.layout import (
     B_ARM_LEN,
+    B_FOREARM,
+    B_HAND,
     B_HEAD_RISE,
     B_HIP_Z,
     B_LEG_HALF,
+    B_MODEL,
     B_R_ARM,
+    B_R_FORE,
+    B_R_HAND,
     B_R_HEAD,
     B_R_LEG,
     B_R_TRUNK,
+    B_R_UPPER,
     B_SHOULDER_HALF,
     B_SHOULDER_RISE,
     B_TRUNK_TOP,
+    B_UPPER_ARM,
+    POSE_EXT,
 )
 
 
 @njit(cache=True, error_model="numpy")
-def human_pose(P, x, y, heading, fwd, lat, W):
-    """Body capsules (W.ha, W.hb, W.hr), shoulders (W.sh) and trunk frame (W.tr, columns x, y, z)."""
-    pose_body(P.body, x, y, heading, fwd, lat, W.ha, W.hb, W.hr, W.sh, W.tr)
+def human_pose(P, pose, W):
+    """Body capsules (W.ha, W.hb, W.hr), shoulders (W.sh) and trunk frame (W.tr, columns x, y, z) for a pose
+    vector (layout.POSE_ROW's order: x, y, heading, forward and lateral flexion, drop, arm joints)."""
+    pose_body(P.body, pose[0], pose[1], pose[2], pose[3], pose[4], pose, POSE_EXT, W.ha, W.hb, W.hr, W.sh, W.tr)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def pose_body(b, x, y, heading, fwd, lat, ha, hb, hr, sh, tr):
-    """human_pose on the arrays themselves (the hot path: see the module docstring)."""
+def pose_body(b, x, y, heading, fwd, lat, ext, e0, ha, hb, hr, sh, tr):
+    """human_pose on the arrays themselves (the hot path: see the module docstring). ``ext[e0]`` is the hip's
+    drop and ``ext[e0 + 1 + 5 k + j]`` arm k's joint j; the paper's worker (BODY_PARAMS MODEL 0) reads neither."""
     ch, shh = np.cos(heading), np.sin(heading)
     cf, sf = np.cos(fwd), np.sin(fwd)
     cl, sl = np.cos(lat), np.sin(lat)
@@ -39,7 +50,10 @@ def pose_body(b, x, y, heading, fwd, lat, ha, hb, hr, sh, tr):
     tr[0, 0], tr[1, 0], tr[2, 0] = xb0 * ch - xb1 * shh, xb0 * shh + xb1 * ch, xb2
     tr[0, 1], tr[1, 1], tr[2, 1] = yb0 * ch - yb1 * shh, yb0 * shh + yb1 * ch, yb2
     tr[0, 2], tr[1, 2], tr[2, 2] = zb0 * ch - zb1 * shh, zb0 * shh + zb1 * ch, zb2
+    articulated = b[B_MODEL] != 0.0
     hz = b[B_HIP_Z]
+    if articulated:
+        hz += ext[e0]
     lx, ly = -shh, ch  # body left in the world
     # legs
     for k in range(2):
@@ -62,6 +76,55 @@ def pose_body(b, x, y, heading, fwd, lat, ha, hb, hr, sh, tr):
             sh[k, r] = ha[2, r] + b[B_SHOULDER_RISE] * tr[r, 2] + sgn * b[B_SHOULDER_HALF] * tr[r, 1]
             ha[4 + k, r] = sh[k, r]
             hb[4 + k, r] = sh[k, r]
-        low = sh[k, 2] - (b[B_ARM_LEN] - b[B_R_ARM])
-        hb[4 + k, 2] = low if low > b[B_R_ARM] else b[B_R_ARM]
-        hr[4 + k] = b[B_R_ARM]
+        if articulated:
+            pose_arm(b, ext, e0 + 1 + 5 * k, k, sh, tr, ha, hb, hr)
+        else:
+            low = sh[k, 2] - (b[B_ARM_LEN] - b[B_R_ARM])
+            hb[4 + k, 2] = low if low > b[B_R_ARM] else b[B_R_ARM]
+            hr[4 + k] = b[B_R_ARM]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def arm_chain(q0, q1, q2, q3, q4, l1, l2, l3):
+    """Elbow, wrist and fingertip of the right arm in the shoulder frame (x forward, y left, z up along the
+    trunk) for joint angles q [rad]: ``human.reach.arm_points``'s kinematics, written out in scalars so that the
+    step allocates nothing. The upper arm's frame is Rx(-q1) Ry(-q0) Rz(q2); elbow and wrist turn it by Ry(-q3)
+    and Ry(-q4); each segment points along its frame's -z."""
+    c0, s0, c1, s1, c2, s2 = np.cos(q0), np.sin(q0), np.cos(q1), np.sin(q1), np.cos(q2), np.sin(q2)
+    # columns x (u0) and z (u2) of the upper arm's frame
+    u0x, u0y, u0z = c0 * c2, c1 * s2 + s1 * s0 * c2, -s1 * s2 + c1 * s0 * c2
+    u2x, u2y, u2z = -s0, s1 * c0, c1 * c0
+    c3, s3 = np.cos(q3), np.sin(q3)
+    f0x, f0y, f0z = c3 * u0x + s3 * u2x, c3 * u0y + s3 * u2y, c3 * u0z + s3 * u2z
+    f2x, f2y, f2z = -s3 * u0x + c3 * u2x, -s3 * u0y + c3 * u2y, -s3 * u0z + c3 * u2z
+    c4, s4 = np.cos(q4), np.sin(q4)
+    h2x, h2y, h2z = -s4 * f0x + c4 * f2x, -s4 * f0y + c4 * f2y, -s4 * f0z + c4 * f2z
+    ex, ey, ez = -l1 * u2x, -l1 * u2y, -l1 * u2z
+    wx, wy, wz = ex - l2 * f2x, ey - l2 * f2y, ez - l2 * f2z
+    return ex, ey, ez, wx, wy, wz, wx - l3 * h2x, wy - l3 * h2y, wz - l3 * h2z
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _to_world(sh, tr, k, lx, ly, lz, out, i):
+    """Point (lx, ly, lz) of arm k's shoulder frame (the left arm mirrors y) into out[i]."""
+    if k == 0:
+        ly = -ly
+    for r in range(3):
+        out[i, r] = sh[k, r] + lx * tr[r, 0] + ly * tr[r, 1] + lz * tr[r, 2]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def pose_arm(b, ext, j0, k, sh, tr, ha, hb, hr):
+    """Arm k of the articulated worker (joints ext[j0:j0 + 5]): capsules upper arm 4 + k, forearm 6 + k and
+    hand 8 + k. The hand's capsule ends its radius short of the fingertip, so its surface reaches the tip."""
+    r_hand = b[B_R_HAND]
+    ex, ey, ez, wx, wy, wz, tx, ty, tz = arm_chain(ext[j0], ext[j0 + 1], ext[j0 + 2], ext[j0 + 3], ext[j0 + 4],
+                                                   b[B_UPPER_ARM], b[B_FOREARM], b[B_HAND] - r_hand)
+    _to_world(sh, tr, k, ex, ey, ez, hb, 4 + k)
+    _to_world(sh, tr, k, ex, ey, ez, ha, 6 + k)
+    _to_world(sh, tr, k, wx, wy, wz, hb, 6 + k)
+    _to_world(sh, tr, k, wx, wy, wz, ha, 8 + k)
+    _to_world(sh, tr, k, tx, ty, tz, hb, 8 + k)
+    hr[4 + k] = b[B_R_UPPER]
+    hr[6 + k] = b[B_R_FORE]
+    hr[8 + k] = r_hand

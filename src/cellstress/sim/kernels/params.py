@@ -8,13 +8,13 @@ from typing import NamedTuple
 import numpy as np
 
 from cellstress.core.jit import njit
-from cellstress.sim.layout import N_BODY_CAPSULES
+from cellstress.sim.layout import MAX_CAPSULES
 
 
 class SimParams(NamedTuple):
     scal: np.ndarray  # (N_SCAL,) laid out as sim.layout.SCALARS
     spa: int  # steps per action
-    act: np.ndarray  # (n_actions, 4): walks, heading change, target forward / lateral flexion
+    act: np.ndarray  # (n_actions, N_ACT_COLUMNS) laid out as human.actions.ACT_COLUMNS
     body: np.ndarray  # (N_BODY_PARAMS,) laid out as sim.layout.BODY_PARAMS
     base: np.ndarray  # (4, 4) robot base in the world
     parents: np.ndarray  # (nj,) int64
@@ -110,6 +110,8 @@ class Work(NamedTuple):
     xv: np.ndarray  # (nx,) each robot's v_R at the step
     xtau: np.ndarray  # (nx,) path time
     xphase: np.ndarray  # (nx,) stop phase
+    ext0: np.ndarray  # (11,) the articulated worker's drop and arm joints when the action began (move_worker)
+    ext1: np.ndarray  # (11,) the same for the pose being tried
 
 
 @njit(cache=True, error_model="numpy")
@@ -120,10 +122,10 @@ def make_work(P):
     return Work(
         np.zeros(nj), np.zeros(nj), np.zeros((nj, 3, 3)), np.zeros((nj, 3)),
         np.zeros((nc, 3)), np.zeros((nc, 3)),
-        np.zeros((N_BODY_CAPSULES, 3)), np.zeros((N_BODY_CAPSULES, 3)), np.zeros(N_BODY_CAPSULES),
+        np.zeros((MAX_CAPSULES, 3)), np.zeros((MAX_CAPSULES, 3)), np.zeros(MAX_CAPSULES),
         np.zeros((2, 3)), np.zeros((3, 3)), np.zeros(P.fences.shape[0] + 1, dtype=np.int64),
         np.zeros(3),
         np.zeros(2 * nc), np.zeros(2 * nc), np.full(2, np.nan), P.fences.copy(),
         np.zeros(njx), np.zeros(njx), np.zeros((njx, 3, 3)), np.zeros((njx, 3)), np.zeros((ncx, 3)),
-        np.zeros((ncx, 3)), np.zeros(nx), np.zeros(nx), np.zeros(nx),
+        np.zeros((ncx, 3)), np.zeros(nx), np.zeros(nx), np.zeros(nx), np.zeros(11), np.zeros(11),
     )

@@ -14,20 +14,31 @@ from cellstress.sim.geometry import (
     polygon_distance,
     segment_rectangle_xyz,
 )
-from cellstress.sim.layout import B_HEAD_RISE, B_R_HEAD, B_R_TRUNK, B_SHOULDER_HALF, DEV_SCANNER, N_BODY_CAPSULES
+from cellstress.sim.layout import (
+    B_ARM_LEN,
+    B_HEAD_RISE,
+    B_MODEL,
+    B_N_CAPS,
+    B_R_HEAD,
+    B_R_TRUNK,
+    B_SHOULDER_HALF,
+    DEV_SCANNER,
+)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
-    """Does device d detect the worker: a body capsule (legs, trunk, head, arms at rest) in its region?
+    """Does device d detect the worker: a body capsule (legs, trunk, head, arms) in its region?
 
-    The reach volumes are not seen: they stand for where an arm *could* strike, and the worst-case worker
-    keeps the arm back until it can. ISO 13855's reach allowance C covers exactly this.
+    The paper worker's reach volumes are not seen: they stand for where an arm *could* strike, and the
+    worst-case worker keeps the arm back until it can. ISO 13855's reach allowance C covers exactly this. The
+    articulated worker's arms are capsules where they are, and are seen there.
     """
+    nh = int(body[B_N_CAPS])
     if dev_kind[d] == DEV_SCANNER:
         H = dev_rect[d, 4]
         start, count = dev_poly[d, 0], dev_poly[d, 1]
-        for c in range(N_BODY_CAPSULES):
+        for c in range(nh):
             a0, a1, a2, b0, b1, b2, r = ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2], hr[c]
             lo, hi = min(a2, b2), max(a2, b2)
             if H < lo - r or H > hi + r:
@@ -48,9 +59,11 @@ def device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
             dev_rect[d, 4], dev_rect[d, 5]
         # no body capsule is further than this from the hip axis in plan view
         extent = body[B_SHOULDER_HALF] + body[B_R_TRUNK] + body[B_HEAD_RISE]
+        if body[B_MODEL] != 0.0:
+            extent += body[B_ARM_LEN]
         if point_segment_2d(ha[2, 0], ha[2, 1], x0, y0, x1, y1) > extent:
             return False
-        for c in range(N_BODY_CAPSULES):
+        for c in range(nh):
             if segment_rectangle_xyz(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2],
                                      x0, y0, x1, y1, zlo, zhi)[0] <= hr[c]:
                 return True
@@ -74,37 +87,58 @@ def feet_ok(r, fl, obs_verts, obs_poly, fences, x, y):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def trunk_clear(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr):
-    """Trunk, head and arms (from the shoulders down) do not pass through any fence panel, and trunk and head
-    do not enter any obstacle.
+def body_blocked(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr):
+    """Bit c set: body capsule c passes through a fence panel or into an obstacle; 0: the pose is allowed.
 
-    The shoulders matter most: the reach volumes hang on them, so a shoulder past a panel would reach
-    around it for free. (Where the hands can get past a panel is limited separately, by fence_detour.) The
-    hanging arms are not held off obstacles: bent over a table they would hit its top, which the model's fixed
-    arm pose cannot avoid (the articulated worker can); the reach volumes ignore obstacles likewise.
+    Trunk, head and arms are held off fence panels, and trunk and head off obstacles. The shoulders matter most
+    for the paper's worker: the reach volumes hang on them, so a shoulder past a panel would reach around it
+    for free. (Where its hands can get past a panel is limited separately, by fence_detour.) Its hanging arms
+    are not held off obstacles: bent over a table they would hit its top, which its fixed arm pose cannot
+    avoid; the reach volumes ignore obstacles likewise. The articulated worker's arms (upper arms, forearms,
+    hands) are held off obstacles as well: its arms do not pass through the table.
     """
-    if obs_poly.shape[0] and not obstacles_clear(obs_verts, obs_poly, obs_box, ha, hb, hr):
-        return False
+    nh = int(body[B_N_CAPS])
+    blocked = 0
+    if obs_poly.shape[0]:
+        blocked = obstacles_blocked(obs_verts, obs_poly, obs_box, ha, hb, hr, 4 if nh == 6 else nh)
+        if blocked and nh == 6:
+            return blocked
     extent = body[B_HEAD_RISE] + body[B_R_HEAD] + body[B_SHOULDER_HALF]
+    if nh != 6:
+        extent += body[B_ARM_LEN]
     for f in range(fences.shape[0]):
         x0, y0, x1, y1, zlo, zhi = fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3], fences[f, 4], fences[f, 5]
         if point_segment_2d(ha[2, 0], ha[2, 1], x0, y0, x1, y1) > extent:
             continue
-        for c in (2, 3, 4, 5):
+        for c in range(2, nh):
+            if blocked >> c & 1:
+                continue
             if segment_rectangle_xyz(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2],
                                      x0, y0, x1, y1, zlo, zhi)[0] < hr[c]:
-                return False
-    return True
+                blocked |= 1 << c
+                if nh == 6:
+                    return blocked
+    return blocked
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def trunk_clear(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr):
+    """No body capsule passes through a fence panel or into an obstacle (``body_blocked``)."""
+    return body_blocked(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr) == 0
 
 
 # Not inlined: move_worker is inlined into step_action and worker_paths, and one shared compiled copy of this
 # loop costs a cold compile less than two inlined ones (it runs once per time step either way).
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
-def obstacles_clear(obs_verts, obs_poly, obs_box, ha, hb, hr):
-    """The trunk and head capsules (2, 3) keep out of every obstacle's prism."""
+def obstacles_blocked(obs_verts, obs_poly, obs_box, ha, hb, hr, n_caps):
+    """Bit c set: capsule c (of 2 .. n_caps - 1: trunk, head and the articulated worker's arms) enters an
+    obstacle's prism."""
+    blocked = 0
     for o in range(obs_poly.shape[0]):
         h = obs_box[o, 4]
-        for c in (2, 3):
+        for c in range(2, n_caps):
+            if blocked >> c & 1:
+                continue
             r = hr[c]
             if min(ha[c, 2], hb[c, 2]) - r >= h:
                 continue
@@ -113,5 +147,7 @@ def obstacles_clear(obs_verts, obs_poly, obs_box, ha, hb, hr):
                 continue
             if capsule_touches_prism(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2], r, obs_verts,
                                      obs_poly[o, 0], obs_poly[o, 1], h):
-                return False
-    return True
+                blocked |= 1 << c
+                if n_caps == 4:
+                    return blocked
+    return blocked

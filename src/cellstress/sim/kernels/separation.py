@@ -19,6 +19,7 @@ from cellstress.sim.layout import (
     M_RZ,
     N_BODY_CAPSULES,
     PART_LEFT_REACH,
+    PART_RIGHT_REACH,
 )
 
 
@@ -29,8 +30,11 @@ def _set_reach_hit(row, q):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
-               n_near, row):
+               n_near, row, n_caps):
     """d_HR: minimum distance between the robot capsules and the body capsules or reach volumes.
+
+    ``n_caps`` body capsules: the paper's worker has six and its two reach volumes; the articulated worker has
+    ten (its arms are capsules where they are) and no reach volumes.
 
     Reach volumes first, nearest (capsule, arm) pair first: they usually hold the minimum, and the bound
     they give lets most body-capsule pairs be skipped after a one-line test. Writes distance,
@@ -44,7 +48,9 @@ def separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, 
     # Reach volumes lie inside the arm-length ball around their shoulder, so |p - s| - L bounds the distance
     # from below. Visit (capsule, arm) pairs from the smallest bound up; stop when the bound passes the best.
     L = arm_len + 2.0 * grid_h
-    for c in range(nc):
+    n_vol = nc if n_caps == N_BODY_CAPSULES else 0  # robot capsules to test against the reach volumes
+    best_h = -1
+    for c in range(n_vol):
         abx, aby, abz = rb[c, 0] - ra[c, 0], rb[c, 1] - ra[c, 1], rb[c, 2] - ra[c, 2]
         ll = abx * abx + aby * aby + abz * abz
         for side in range(2):
@@ -57,7 +63,7 @@ def separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, 
     while True:
         m = -1
         lo = best
-        for i in range(2 * nc):
+        for i in range(2 * n_vol):
             if lbs[i] < lo:
                 lo = lbs[i]
                 m = i
@@ -108,7 +114,7 @@ def separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, 
         r = cap_r[c]
         mx, my, mz = 0.5 * (ra[c, 0] + rb[c, 0]), 0.5 * (ra[c, 1] + rb[c, 1]), 0.5 * (ra[c, 2] + rb[c, 2])
         half = 0.5 * np.sqrt((rb[c, 0] - ra[c, 0]) ** 2 + (rb[c, 1] - ra[c, 1]) ** 2 + (rb[c, 2] - ra[c, 2]) ** 2)
-        for h in range(N_BODY_CAPSULES):
+        for h in range(n_caps):
             hx, hy, hz = 0.5 * (ha[h, 0] + hb[h, 0]), 0.5 * (ha[h, 1] + hb[h, 1]), 0.5 * (ha[h, 2] + hb[h, 2])
             hh = 0.5 * np.sqrt((hb[h, 0] - ha[h, 0]) ** 2 + (hb[h, 1] - ha[h, 1]) ** 2
                                + (hb[h, 2] - ha[h, 2]) ** 2)
@@ -120,11 +126,11 @@ def separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, 
                 ha[h, 0], ha[h, 1], ha[h, 2], hb[h, 0], hb[h, 1], hb[h, 2])
             d = np.sqrt(d2) - r - hr[h]
             if d < best:
-                best, best_cap, best_part = d, c, h
+                best, best_cap, best_part, best_h = d, c, (h if h < N_BODY_CAPSULES else h + 2), h
                 row[M_RX], row[M_RY], row[M_RZ] = c1x, c1y, c1z
                 row[M_HX], row[M_HY], row[M_HZ] = c2x, c2y, c2z
     # surface points: step from the axis points towards each other by the radii
-    if best_part >= PART_LEFT_REACH:
+    if PART_LEFT_REACH <= best_part <= PART_RIGHT_REACH:
         s = sh[best_part - PART_LEFT_REACH]
         dx, dy, dz = s[0] - row[M_RX], s[1] - row[M_RY], s[2] - row[M_RZ]
         n = np.sqrt(dx * dx + dy * dy + dz * dz)
@@ -139,7 +145,7 @@ def separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, 
         n = np.sqrt(dx * dx + dy * dy + dz * dz)
         if n > 0:
             dx, dy, dz = dx / n, dy / n, dz / n
-        r, hr = cap_r[best_cap], hr[best_part]
+        r, hr = cap_r[best_cap], hr[best_h]
         row[M_RX], row[M_RY], row[M_RZ] = row[M_RX] + r * dx, row[M_RY] + r * dy, row[M_RZ] + r * dz
         row[M_HX], row[M_HY], row[M_HZ] = row[M_HX] - hr * dx, row[M_HY] - hr * dy, row[M_HZ] - hr * dz
     row[M_D] = best if best > 0.0 else 0.0

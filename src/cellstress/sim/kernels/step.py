@@ -18,11 +18,24 @@ from cellstress.sim.kernels.fences import collect_near_fences
 from cellstress.sim.kernels.reach import reach_value_at
 from cellstress.sim.kernels.robot import live_path_time, other_robots, robot_at
 from cellstress.sim.kernels.scaling import command, commands_due
-from cellstress.sim.kernels.sensing import device_sees, feet_ok, trunk_clear
+from cellstress.sim.kernels.sensing import body_blocked, device_sees, feet_ok
 from cellstress.sim.kernels.separation import separation
 from cellstress.sim.layout import (
+    A_DIR,
+    A_DROP,
+    A_FWD,
+    A_HANG,
+    A_LAT,
+    A_Q0,
+    A_SET_ARMS,
+    A_SET_STANCE,
+    A_SET_TRUNK,
+    A_TURN,
+    A_WALK,
     B_ARM_LEN,
     B_BODY_RADIUS,
+    B_MODEL,
+    B_N_CAPS,
     B_WALK_SPEED,
     C_DT,
     C_DTOL,
@@ -32,6 +45,7 @@ from cellstress.sim.layout import (
     C_VTOL,
     DEV_DOOR,
     M_ACTION,
+    M_DROP,
     M_FWD,
     M_HEADING,
     M_LAT,
@@ -50,15 +64,18 @@ from cellstress.sim.layout import (
     M_Y,
     MAX_DOORS,
     MAX_ROBOTS,
-    N_BODY_CAPSULES,
+    NO_WALK_BELOW,
     NS,
+    POSE_EXT,
     S_A_SIG,
     S_A_T,
     S_A_TAU,
     S_A_TGT,
     S_ACTIONS,
+    S_ARM,
     S_DOOR_OPEN,
     S_DOOR_REQ,
+    S_DROP,
     S_FWD,
     S_HEADING,
     S_K,
@@ -96,7 +113,8 @@ def sense_and_measure(P, state, W, row, action):
     k = state[S_K]
     t = k * dt
     ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
-    pose_body(P.body, state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT], ha, hb, hr, sh, tr)
+    pose_body(P.body, state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT], state, S_DROP,
+              ha, hb, hr, sh, tr)
     seen = 0
     dev_kind, dev_rect, dev_poly, dev_verts, body = P.dev_kind, P.dev_rect, P.dev_poly, P.dev_verts, P.body
     for d in range(dev_kind.shape[0]):
@@ -125,7 +143,7 @@ def sense_and_measure(P, state, W, row, action):
     # One inlined copy of separation: a second, fence-free copy (n_near the constant 0) cost ~8 s of a cold
     # compile for no measurable speed (the fence code is skipped by a branch on n_near either way).
     d_hr = separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, tr, ha, hb, hr, lbs, ts, q,
-                      n_near, row)
+                      n_near, row, int(P.body[B_N_CAPS]))
     # v_R is the speed of the robot that owns the nearest capsule: the contact criterion and the reward judge
     # the robot the worker is nearest (docs/architecture.md, several robots)
     link = int(row[M_LINK])
@@ -140,6 +158,8 @@ def sense_and_measure(P, state, W, row, action):
     row[M_T] = t
     row[M_X], row[M_Y], row[M_HEADING] = state[S_X], state[S_Y], state[S_HEADING]
     row[M_FWD], row[M_LAT] = state[S_FWD], state[S_LAT]
+    for i in range(11):
+        row[M_DROP + i] = state[S_DROP + i]
     row[M_V] = v
     row[M_SEEN] = seen
     row[M_PHASE] = phase
@@ -264,6 +284,7 @@ def step_action(P, state, action, W, out, row0):
         return 0
     spa = P.spa
     h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
+    begin_action(P, state, W)
     n = 0
     for j in range(1, spa + 1):
         move_worker(P, state, action, h0, f0, l0, j / spa, W)
@@ -277,45 +298,97 @@ def step_action(P, state, action, W, out, row0):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def begin_action(P, state, W):
+    """Keep the articulated worker's stance and arm joints as the action begins (move_worker moves from them)."""
+    if P.body[B_MODEL] != 0.0:
+        for i in range(11):
+            W.ext0[i] = state[S_DROP + i]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def move_worker(P, state, action, h0, f0, l0, frac, W):
-    """The worker's own motion over one time step of ``action`` (begun at heading h0 and posture f0, l0):
-    ``frac`` of the action done. It depends on the actions and the fixed layout only, never on the robot, except
-    through a door with guard locking (it opens once the robot is at rest: ``doors.unlock_doors``)."""
-    walks = P.act[action, 0]
+    """The worker's own motion over one time step of ``action`` (begun at heading h0 and posture f0, l0, and
+    for the articulated worker the stance and arms in W.ext0): ``frac`` of the action done. It depends on the
+    actions and the fixed layout only, never on the robot, except through a door with guard locking (it opens
+    once the robot is at rest: ``doors.unlock_doors``)."""
+    act = P.act
+    walks = act[action, A_WALK]
     body, fences, floor, obs_verts, obs_poly, obs_box = P.body, W.fences, P.floor, P.obs_verts, P.obs_poly, P.obs_box
     ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
+    articulated = body[B_MODEL] != 0.0
     x, y = state[S_X], state[S_Y]
     t = state[S_K] * P.scal[C_DT]
     place_doors(P, state, fences, t)
-    h = h0 + P.act[action, 1] * frac
-    f = f0 + (P.act[action, 2] - f0) * frac
-    lt = l0 + (P.act[action, 3] - l0) * frac
+    h = h0 + act[action, A_TURN] * frac
+    f_to = act[action, A_FWD] if act[action, A_SET_TRUNK] != 0.0 else f0
+    l_to = act[action, A_LAT] if act[action, A_SET_TRUNK] != 0.0 else l0
+    f = f0 + (f_to - f0) * frac
+    lt = l0 + (l_to - l0) * frac
+    ext = W.ext1
+    if articulated:
+        blend_limbs(act, action, W.ext0, f, frac, ext)
+        if state[S_DROP] < NO_WALK_BELOW:
+            walks = 0.0  # crouched or kneeling: the feet stay
     nx, ny = x, y
     if walks != 0.0:
-        stride = body[B_WALK_SPEED] * P.scal[C_DT]
-        nx, ny = x + stride * np.cos(h), y + stride * np.sin(h)
+        stride = body[B_WALK_SPEED] * P.scal[C_DT] * walks
+        nx, ny = x + stride * np.cos(h + act[action, A_DIR]), y + stride * np.sin(h + act[action, A_DIR])
         if not feet_ok(body[B_BODY_RADIUS], floor, obs_verts, obs_poly, fences, nx, ny):
             # walking into a closed door pushes it (at the time of the step being taken)
             push_doors(P, state, body[B_BODY_RADIUS], nx, ny, t + P.scal[C_DT])
             nx, ny = x, y
-    # If the new posture would put the trunk through a fence, keep the old posture where it stands; if that
-    # fails too, stay put. (A loop, so that pose_body and trunk_clear are inlined once, not twice: each
-    # copy cost seconds of a cold compile, in step_action and worker_paths alike.)
-    for attempt in range(2):
-        pose_body(body, nx, ny, h, f, lt, ha, hb, hr, sh, tr)
-        if trunk_clear(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr):
+    # If the new pose would put a body part through a fence (or the articulated worker's arm into an obstacle),
+    # the articulated worker first holds the arm that is in the way where it was; then either keeps the old
+    # posture where it stands; if that fails too, stays put. (A loop, so that pose_body and body_blocked are
+    # inlined once: each copy cost seconds of a cold compile, in step_action and worker_paths alike.)
+    final = False
+    for attempt in range(3):
+        pose_body(body, nx, ny, h, f, lt, ext, 0, ha, hb, hr, sh, tr)
+        blocked = body_blocked(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr)
+        if blocked == 0:
             break
-        h, f, lt = state[S_HEADING], state[S_FWD], state[S_LAT]
-        if attempt == 1:
+        if final:
             nx, ny = x, y
+            break
+        if attempt == 0 and articulated and blocked >> 4 != 0:
+            for k in range(2):
+                if (blocked >> (4 + k) | blocked >> (6 + k) | blocked >> (8 + k)) & 1:
+                    for j in range(5):
+                        ext[1 + 5 * k + j] = state[S_ARM + 5 * k + j]
+            continue
+        h, f, lt = state[S_HEADING], state[S_FWD], state[S_LAT]
+        if articulated:
+            for i in range(11):
+                ext[i] = state[S_DROP + i]
+        final = True
     state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT] = nx, ny, h, f, lt
+    if articulated:
+        for i in range(11):
+            state[S_DROP + i] = ext[i]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def blend_limbs(act, action, ext0, fwd, frac, ext):
+    """The articulated worker's stance and arm joints ``frac`` of the way from ext0 to the action's targets
+    (a target the action does not set stays where it was; hanging arms follow the trunk's flexion ``fwd``)."""
+    d_to = act[action, A_DROP] if act[action, A_SET_STANCE] != 0.0 else ext0[0]
+    ext[0] = ext0[0] + (d_to - ext0[0]) * frac
+    set_arms = act[action, A_SET_ARMS] != 0.0
+    for k in range(2):
+        for j in range(5):
+            i = 1 + 5 * k + j
+            to = act[action, A_Q0 + j] if set_arms else ext0[i]
+            if set_arms and j == 0 and act[action, A_HANG] != 0.0:
+                to = fwd
+            ext[i] = ext0[i] + (to - ext0[i]) * frac
 
 
 @njit(cache=True, error_model="numpy")
 def worker_paths(P, s0, actions, W, out):
-    """The worker's poses (x, y, heading, forward, lateral flexion) at every time step of each episode of
-    ``actions`` (n, n_actions) played from s0, as if no contact ended it: the open-loop part of the simulation
-    (``move_worker``), without robot, devices or measuring. out: (n, n_actions * spa, 5). A door without guard
+    """The worker's poses (layout.POSE_STATE: x, y, heading, forward, lateral flexion, drop, arm joints) at every
+    time step of each episode of ``actions`` (n, n_actions) played from s0, as if no contact ended it: the
+    open-loop part of the simulation (``move_worker``), without robot, devices or measuring.
+    out: (n, n_actions * spa, N_POSE). A door without guard
     locking opens here as played; one with guard locking stays locked (the robot's rest is not simulated)."""
     state = np.empty(NS)
     spa = P.spa
@@ -324,23 +397,29 @@ def worker_paths(P, s0, actions, W, out):
         k = 0
         for a in range(actions.shape[1]):
             h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
+            begin_action(P, state, W)
             for j in range(1, spa + 1):
                 move_worker(P, state, actions[e, a], h0, f0, l0, j / spa, W)
                 state[S_K] += 1.0  # (a door pushed opens on the clock)
                 out[e, k, 0], out[e, k, 1], out[e, k, 2] = state[S_X], state[S_Y], state[S_HEADING]
                 out[e, k, 3], out[e, k, 4] = state[S_FWD], state[S_LAT]
+                for i in range(11):
+                    out[e, k, POSE_EXT + i] = state[S_DROP + i]
                 k += 1
 
 
 @njit(cache=True, error_model="numpy")
 def worker_point_distances(P, W, poses, points, out):
-    """out[i, j]: distance from the worker at poses[i] (x, y, heading, forward, lateral flexion) to the point
-    points[i, j], as ``separation`` measures the worker's side of d_HR: the nearer of the two reach volumes
-    (fences respected) and the body capsules; inf for a NaN point. The robot plays no part."""
+    """out[i, j]: distance from the worker at poses[i] (layout.POSE_STATE's order) to the point points[i, j], as
+    ``separation`` measures the paper worker's side of d_HR: the nearer of the two reach volumes (fences
+    respected) and the body capsules; inf for a NaN point. The robot plays no part. For the articulated worker
+    the reach volumes are its conservative envelope: where its arms could be within the action that follows."""
     arm, origin, grid_h = P.body[B_ARM_LEN], P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H]
     ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
+    n_caps = int(P.body[B_N_CAPS])
     for i in range(poses.shape[0]):
-        pose_body(P.body, poses[i, 0], poses[i, 1], poses[i, 2], poses[i, 3], poses[i, 4], ha, hb, hr, sh, tr)
+        pose_body(P.body, poses[i, 0], poses[i, 1], poses[i, 2], poses[i, 3], poses[i, 4], poses[i], POSE_EXT,
+                  ha, hb, hr, sh, tr)
         n_near = collect_near_fences(P.fences, sh, W.near, arm + 0.05)
         for j in range(points.shape[1]):
             px, py, pz = points[i, j, 0], points[i, j, 1], points[i, j, 2]
@@ -351,7 +430,7 @@ def worker_point_distances(P, W, poses, points, out):
             for side in range(2):
                 best = min(best, reach_value_at(P.reach, origin, grid_h, arm, P.fences, W.near, sh, tr, side, n_near,
                                               px, py, pz))
-            for c in range(N_BODY_CAPSULES):
+            for c in range(n_caps):
                 d2 = segment_segment_xyz(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2],
                                          px, py, pz, px, py, pz)[0]
                 best = min(best, np.sqrt(d2) - hr[c])
