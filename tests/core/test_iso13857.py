@@ -190,3 +190,33 @@ def test_bad_whole_body_arguments_raise():
         whole_body_access(-1, "slot")
     with pytest.raises(ValueError):
         whole_body_access(200, "oval")
+
+
+def _doc_tables() -> list[list[list[str]]]:
+    """The markdown tables of docs/worker.md, each a list of rows of cell texts (header and rule dropped)."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "worker.md").read_text(encoding="utf-8")
+    tables, cur = [], []
+    for line in [*text.splitlines(), ""]:
+        if line.startswith("|"):
+            cur.append([c.strip() for c in line.strip().strip("|").split("|")])
+        elif cur:
+            tables.append(cur[2:])
+            cur = []
+    return tables
+
+
+def test_docs_print_the_modules_tables():
+    """docs/worker.md shows Tables 2, 1 and 4 exactly as the module holds them, bold exactly on checked cells."""
+    docs = {len(t[0]): t for t in _doc_tables() if t and t[0][0] in ("2700", "2500")}
+    for t in (TABLE_2, TABLE_1):
+        rows = docs[len(t.b_mm) + 1]
+        assert [float(r[0]) for r in rows] == list(reversed(t.a_mm))
+        for r in rows:
+            a = float(r[0])
+            assert [float(x.strip("*")) for x in r[1:]] == list(t.c_mm[t.a_mm.index(a)])
+            assert [x.startswith("**") for x in r[1:]] == [(a, b) in t.checked for b in t.b_mm], (t.table, a)
+    t4 = next(t for t in _doc_tables() if t and t[0][0].startswith("0 < e"))
+    assert [(float(r[1]), float(r[2]), float(r[3]), r[4]) for r in t4] == [
+        (row.slot_mm, row.square_mm, row.round_mm, row.body_part) for row in iso.TABLE_4]

@@ -109,3 +109,16 @@ def test_every_posture_and_gait_says_where_it_comes_from():
         assert 0 < g.speed_fraction <= 1 and "ssumption" in g.derivation
     assert set(GAITS) == {"step-back", "side-step"}
     assert "assumption" in POSTURES["tiptoe"].derivation
+
+
+def test_docs_print_the_body_sizes():
+    """docs/worker.md's body-size table is the module's, to the millimetre."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "worker.md").read_text(encoding="utf-8")
+    rows = {ln.split("|")[1].strip(): [float(x) for x in ln.split("|")[2:-1]]
+            for ln in text.splitlines() if ln.startswith("| p") and "male" in ln}
+    assert set(rows) == set(KEYS)
+    for key, b in BODY_SIZES.items():
+        want = [b.stature, b.upper_arm, b.forearm, b.hand, b.arm_length, b.shoulder_breadth, b.hip_height]
+        assert rows[key] == pytest.approx(want, abs=6e-4), key  # printed to the mm
