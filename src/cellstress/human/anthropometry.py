@@ -1,8 +1,9 @@
 """Body sizes from the 5th percentile woman to the 95th percentile man, postures and gait speeds, with sources.
 
-Body sizes (``BODY_SIZES``). One survey: the British adults aged 19 to 65 of Pheasant and Haslegrave
-(*Bodyspace*), as tabulated (5th, 50th and 95th percentile, men and women) on the dimension pages of City
-University of Hong Kong's "Online Anthropometry" (Chapter 2, dimension N on page Ch2-N):
+Body sizes (``BODY_SIZES``). One survey: British adults aged 19 to 65, 5th, 50th and 95th percentiles of men
+and women, as printed on the dimension pages of City University of Hong Kong's "Online Anthropometry"
+(Chapter 2, dimension N on page Ch2-N). It is the British adult population of Pheasant and Haslegrave's
+*Bodyspace*; the book itself is not in our reference library, only these pages.
 
 - ``stature``: dimension 1, stature (floor to vertex): women 1505 / 1610 / 1710 mm, men 1625 / 1740 / 1855 mm.
 - ``upper_arm``: dimension 22, shoulder-elbow length (acromion to the underside of the elbow, sitting):
@@ -11,8 +12,8 @@ University of Hong Kong's "Online Anthropometry" (Chapter 2, dimension N on page
   reaches a little further, the safe side for a reach search.
 - ``shoulder_breadth``: dimension 18, biacromial breadth: women 325 / 355 / 380 mm, men 365 / 400 / 430 mm.
 - ``forearm``, ``hand``, ``hip_height``: not taken from the survey. Its hand length page (dimension 28) is not in
-  the reference library and the stored copies of dimensions 23 (elbow-fingertip length) and 5 (hip height) lose
-  the women's columns, so these three come from the survey's stature with Drillis & Contini's proportions
+  the reference library and the stored copies of dimensions 23 (elbow-fingertip length) and 5 (hip height) lack
+  the women's 95th percentile and the women's columns, so these three come from the survey's stature with Drillis & Contini's proportions
   (Winter, *Biomechanics and Motor Control of Human Movement*, Fig. 4.1; the ones human/body.py uses):
   forearm 0.146 H, hand 0.108 H, hip (greater trochanter) 0.530 H. Check against the survey where it has a
   column: the men's hip heights 840 / 920 / 1000 mm against 0.530 H = 861 / 922 / 983 mm.
@@ -43,9 +44,9 @@ HIP_FRACTION = FOOT_HEIGHT_FRACTION + SHANK_FRACTION + THIGH_FRACTION  # 0.530, 
 KNEE_FLEXION_DEG = 135.0
 ANKLE_DORSIFLEXION_DEG = 20.0
 
-SURVEY = ("British adults aged 19-65 (Pheasant & Haslegrave, Bodyspace), as tabulated by City University of Hong "
-          "Kong, Online Anthropometry, Chapter 2: dimensions 1 (stature), 18 (biacromial breadth), 22 "
-          "(shoulder-elbow length)")
+SURVEY = ("British adults aged 19-65 (the population of Pheasant & Haslegrave, Bodyspace) as printed by City "
+          "University of Hong Kong, Online Anthropometry, Chapter 2: dimensions 1 (stature), 18 (biacromial "
+          "breadth), 22 (shoulder-elbow length)")
 
 
 @dataclass(frozen=True)
