@@ -12,11 +12,11 @@ and women, as printed on the dimension pages of City University of Hong Kong's "
   reaches a little further, the safe side for a reach search.
 - ``shoulder_breadth``: dimension 18, biacromial breadth: women 325 / 355 / 380 mm, men 365 / 400 / 430 mm.
 - ``forearm``, ``hand``, ``hip_height``: not taken from the survey. Its hand length page (dimension 28) is not in
-  the reference library and the stored copies of dimensions 23 (elbow-fingertip length) and 5 (hip height) lack
-  the women's 95th percentile and the women's columns, so these three come from the survey's stature with Drillis & Contini's proportions
-  (Winter, *Biomechanics and Motor Control of Human Movement*, Fig. 4.1; the ones human/body.py uses):
-  forearm 0.146 H, hand 0.108 H, hip (greater trochanter) 0.530 H. Check against the survey where it has a
-  column: the men's hip heights 840 / 920 / 1000 mm against 0.530 H = 861 / 922 / 983 mm.
+  the reference library, and the stored copies of dimension 23 (elbow-fingertip length) lack the women's 95th
+  percentile and of dimension 5 (hip height) the women's columns. So these three come from the survey's stature
+  with Drillis & Contini's proportions (Winter, *Biomechanics and Motor Control of Human Movement*, Fig. 4.1;
+  the ones human/body.py uses): forearm 0.146 H, hand 0.108 H, hip (greater trochanter) 0.530 H. Check against
+  the survey where it has a column: the men's hip heights 840 / 920 / 1000 mm against 0.530 H = 861 / 922 / 983.
 
 Postures (``POSTURES``) put the hip (greater trochanter) at a fraction of stature, from Drillis & Contini's
 segment lengths (foot height 0.039 H, shank 0.246 H, thigh 0.245 H; they add up to the standing hip, 0.530 H)
