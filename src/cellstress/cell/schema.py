@@ -39,6 +39,7 @@ from cellstress.core.fields import (
     Record,
 )
 from cellstress.core.records import MAX_DOORS, DoorLeaf
+from cellstress.human.anthropometry import BODY_SIZES
 
 DEFAULT_CRITERION = "contact-while-moving"
 
@@ -296,6 +297,7 @@ def _tagged_union(group: str, default: str | None = None):
 DEVICE_KINDS: tuple[str, ...] = registry.names("devices")
 CRITERIA: tuple[str, ...] = registry.names("criteria")
 WORKER_MODELS: tuple[str, ...] = registry.names("workers")
+BODY_SIZE_NAMES: tuple[str, ...] = tuple(BODY_SIZES)
 DeviceSpec = _tagged_union("devices")
 CriterionSpec = _tagged_union("criteria", DEFAULT_CRITERION)
 
@@ -337,6 +339,9 @@ class HumanSpec(Record):
     """How the worker is modelled (registry group ``workers``). paper: the paper's 30 actions, hanging arms and
     the reach volumes of the arms (Table III's worker); articulated: jointed arms that collide with fences, the
     table and obstacles, crouching, kneeling, tiptoe, stepping back and sideways (docs/worker.md)."""
+    body: Literal[BODY_SIZE_NAMES] | None = None  # type: ignore[valid-type]
+    """A body size from an anthropometric survey, 5th percentile woman to 95th percentile man (docs/worker.md):
+    it sets ``anthropometry``, so give one or the other (read back, a cell has both, and they agree)."""
     start: StartSpec
     """The worker's start pose."""
     starts: tuple[NamedStart, ...] = Field((), max_length=MAX_COUNT)
@@ -353,6 +358,21 @@ class HumanSpec(Record):
     """The largest forward bend of the trunk [deg]."""
     max_lateral_flexion_deg: Annotated[float, Field(ge=0.0, le=60.0)] = 35.0
     """The largest sideways bend of the trunk [deg]."""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _body_size(cls, data: Any) -> Any:
+        if not isinstance(data, dict) or data.get("body") is None or data.get("body") not in BODY_SIZES:
+            return data
+        size = BODY_SIZES[data["body"]]
+        dims = {"height": size.stature, "upper_arm": size.upper_arm, "forearm": size.forearm, "hand": size.hand}
+        given = data.get("anthropometry")
+        if given is not None:
+            given = given.model_dump() if isinstance(given, Anthropometry) else given
+            if given != dims:
+                raise ValueError(f"give body ({data['body']}) or anthropometry, not both: the body size sets the "
+                                 "anthropometry")
+        return {**data, "anthropometry": dims}
 
     @field_validator("starts")
     @classmethod

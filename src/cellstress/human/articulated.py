@@ -32,12 +32,13 @@ from cellstress.human.actions import (
     N_ACT_COLUMNS,
     index_in,
 )
+from cellstress.human.anthropometry import GAITS, POSTURES
 from cellstress.human.reach import JOINT_RANGES_DEG
 
 # Feet: (speed as a fraction of walking speed, direction relative to the heading [deg], turn [deg]).
-# Stepping back and sideways is slower than walking forward (docs/worker.md gives the fractions' sources).
-BACKWARD_SPEED = 0.6
-SIDEWAYS_SPEED = 0.5
+# Stepping back and sideways is slower than walking forward (human.anthropometry.GAITS, docs/worker.md).
+BACKWARD_SPEED = GAITS["step-back"].speed_fraction
+SIDEWAYS_SPEED = GAITS["side-step"].speed_fraction
 MOVES: dict[str, tuple[float, float, float]] = {
     "walk": (1.0, 0.0, 0.0),
     "step-back": (BACKWARD_SPEED, 180.0, 0.0),
@@ -56,12 +57,14 @@ TRUNK: dict[str, tuple[float, float]] = {
     "bend-right": (0.0, -1.0),
 }
 
-# Stances: the hip (greater trochanter) height as a fraction of stature, and tiptoe's rise [m].
-STANDING_HIP = 0.530  # Drillis & Contini (human.body)
-CROUCH_HIP = 0.30  # a deep squat with the heels down: the hip a little above the knee (0.285 H)
-KNEEL_HIP = 0.26  # kneeling upright on both knees: thigh (0.245 H) above the knee on the floor
-TIPTOE_RISE = 0.07  # m, the heels lifted off the floor
+# Stances (human.anthropometry.POSTURES): the hip's height above its standing height.
 STANCES = ("stand-up", "crouch", "kneel", "tiptoe")
+
+
+def stance_drop(stance: str, stature: float) -> float:
+    """The hip's height in ``stance`` above its standing height [m] for a body of ``stature`` [m]."""
+    posture = POSTURES["stand" if stance == "stand-up" else stance]
+    return posture.hip_height(stature) - POSTURES["stand"].hip_height(stature)
 
 # Arm targets [deg] in human.reach's joint order (flexion, abduction, rotation, elbow, wrist); "hang" lets the
 # arms hang plumb whatever the trunk does.
@@ -123,8 +126,6 @@ class ArticulatedWorker:
 
     def action_table(self, max_forward_deg: float, max_lateral_deg: float, stature: float) -> np.ndarray:
         table = np.zeros((len(ACTION_NAMES), N_ACT_COLUMNS))
-        stance_drop = {"stand-up": 0.0, "crouch": (CROUCH_HIP - STANDING_HIP) * stature,
-                       "kneel": (KNEEL_HIP - STANDING_HIP) * stature, "tiptoe": TIPTOE_RISE}
         for i, name in enumerate(ACTION_NAMES):
             move, change = name.split("+")
             speed, direction, turn = MOVES[move]
@@ -134,8 +135,8 @@ class ArticulatedWorker:
                 fwd, lat = TRUNK[change]
                 row[A_SET_TRUNK] = 1.0
                 row[A_FWD], row[A_LAT] = np.deg2rad(max_forward_deg) * fwd, np.deg2rad(max_lateral_deg) * lat
-            elif change in stance_drop:
-                row[A_SET_STANCE], row[A_DROP] = 1.0, stance_drop[change]
+            elif change in STANCES:
+                row[A_SET_STANCE], row[A_DROP] = 1.0, stance_drop(change, stature)
             else:
                 row[A_SET_ARMS] = 1.0
                 row[A_HANG] = 1.0 if change == "hang" else 0.0

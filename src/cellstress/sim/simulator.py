@@ -341,6 +341,19 @@ class Simulator:
         K.worker_paths(self.params, self._s0, acts, self._worker_work(), out)
         return out
 
+    def worker_capsules(self, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The worker's body capsules at each of ``poses`` (n, N_POSE pose vectors): axis ends a, b (n, c, 3) and
+        radii r (n, c), c = 6 for the paper's worker (its reach volumes are not capsules), 10 for the
+        articulated one (``human.body.CAPSULE_PART`` names them)."""
+        poses = np.ascontiguousarray(poses, dtype=np.float64)
+        if poses.ndim != 2 or poses.shape[1] != L.N_POSE:
+            raise ValueError(f"poses must be (n, {L.N_POSE})")
+        n_caps = int(self.params.body[L.B_N_CAPS])
+        a, b = np.empty((len(poses), n_caps, 3)), np.empty((len(poses), n_caps, 3))
+        r = np.empty((len(poses), n_caps))
+        K.pose_capsules(self.params, poses, self._worker_work(), a, b, r)
+        return a, b, r
+
     def worker_distances(self, poses: np.ndarray, points: np.ndarray) -> np.ndarray:
         """Distance from the worker at each of ``poses`` (n, N_POSE pose vectors, as ``worker_paths`` gives them
         and ``layout.row_pose`` reads them from metric rows) to each of its ``points`` (n, m, 3; NaN rows are

@@ -36,6 +36,18 @@ def human_pose(P, pose, W):
     pose_body(P.body, pose[0], pose[1], pose[2], pose[3], pose[4], pose, POSE_EXT, W.ha, W.hb, W.hr, W.sh, W.tr)
 
 
+@njit(cache=True, error_model="numpy")
+def pose_capsules(P, poses, W, A, B, R):
+    """The body capsules of each pose vector poses[i] into A[i], B[i] (axes) and R[i] (radii): (n, n_caps, ...)."""
+    n_caps = A.shape[1]
+    for i in range(poses.shape[0]):
+        human_pose(P, poses[i], W)
+        for c in range(n_caps):
+            R[i, c] = W.hr[c]
+            for r in range(3):
+                A[i, c, r], B[i, c, r] = W.ha[c, r], W.hb[c, r]
+
+
 @njit(cache=True, error_model="numpy", inline="always")
 def pose_body(b, x, y, heading, fwd, lat, ext, e0, ha, hb, hr, sh, tr):
     """human_pose on the arrays themselves (the hot path: see the module docstring). ``ext[e0]`` is the hip's
