@@ -354,6 +354,11 @@ CASES = [
         "robot.capsules",
         ("'auto' or a list of capsules",),
     ),
+    Case("worker-model-unknown", lambda c: c["human"].update(model="robot"), "human.model",
+         ("'paper'", "'articulated'")),
+    Case("body-size-unknown", lambda c: c["human"].update(body="p99-giant"), "human.body", ("'p95-male'",)),
+    Case("body-and-anthropometry", lambda c: c["human"].update(body="p5-female", anthropometry={"height": 1.9}),
+         "human", ("give body (p5-female) or anthropometry, not both",)),
     Case(
         "start-phase-negative",
         lambda c: c["human"].update(starts=[_named_start(c, phase=-1.5)]),

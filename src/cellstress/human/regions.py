@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cellstress.human.body import BodyPose
+from cellstress.human.body import N_CAPSULES, BodyPose
 
 # Body landmarks as fractions of body height (Winter, Fig. 4.1, after Drillis & Contini): knee 0.285 H,
 # chest (nipple) 0.720 H; the iliac crest (top of the pelvis) is taken at 0.600 H (our round number).
@@ -26,7 +26,8 @@ def body_region(part: int, point, pose: BodyPose, height: float, upper_arm: floa
     above. Trunk: pelvis below the iliac crest; above it the back half is back/shoulders, the front half the
     abdomen up to the chest line and the chest above; the top cap within 7 cm of the mid-plane is the neck.
     Head: the face is the front lower part (the outward direction within 73 degrees of forward and less than
-    17 degrees above the head centre), the rest skull/forehead, the underside the neck. Hanging arms: upper arm,
+    17 degrees above the head centre), the rest skull/forehead, the underside the neck. The articulated worker's
+    arms are their capsules: upper arm, forearm, hand. The paper worker's hanging arms: upper arm,
     forearm, hand by the distance from the shoulder. The reach volumes (where a hand *could* be) count as hand
     beyond upper arm + forearm from the shoulder and as forearm within it.
     """
@@ -57,6 +58,12 @@ def body_region(part: int, point, pose: BodyPose, height: float, upper_arm: floa
         if float(d @ fwd) > 0.3 and float(d @ up) < 0.3:
             return "face"
         return "skull-forehead"
+    if part in (8, 9):  # the articulated worker's forearms and hands; its parts 4 and 5 are the upper arms
+        return "forearms"
+    if part in (4, 5) and pose.r.shape[0] > N_CAPSULES:
+        return "upper-arms"
+    if part in (10, 11):
+        return "hands"
     side = (part - 4) % 2
     dist = float(np.linalg.norm(p - pose.shoulders[side]))
     if part in (4, 5):

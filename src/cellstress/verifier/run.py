@@ -224,4 +224,8 @@ def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "al
         raise VerifyError(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}") from None
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise VerifyError(f"workers must be a whole number >= 1, not {workers!r}")
+    if sim.layout.worker.articulated:
+        # its bounds are the paper worker's (30 actions, reach volumes on rigid shoulders: docs/verify.md)
+        raise VerifyError(f"verify proves cells with the paper's worker only; this cell's is "
+                          f"{sim.cell.spec.human.model!r} (human.model)")
     return run_verify(sim, options, workers=workers, out=out, progress=progress)
