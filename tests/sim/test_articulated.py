@@ -174,3 +174,17 @@ def test_the_articulated_worker_is_deterministic_and_replays():
 def test_records_of_the_paper_worker_have_no_limbs():
     rec = Simulator("s3-fence-gap").run(["walk+upright"]).records()[-1]
     assert rec.limbs is None and "limbs" not in rec.model_dump()
+
+
+def test_the_worker_page_example_is_a_valid_worker():
+    """docs/worker.md's cell fragment, played in a cell."""
+    from pathlib import Path
+
+    text = (Path(__file__).parents[2] / "docs" / "worker.md").read_text(encoding="utf-8")
+    block = text.split("```yaml\n", 1)[1].split("```", 1)[0]
+    human = yaml.safe_load(block)["human"]
+    doc = {"name": "doc-example", "robot": ROBOT, "floor": {"xmin": -3.0, "xmax": 3.0, "ymin": -3.0, "ymax": 3.0},
+           "human": human}
+    sim = Simulator(parse_cell(yaml.safe_dump(doc), "doc-example.yaml", None))
+    assert sim.layout.worker.articulated and sim.layout.body.height == 1.855
+    assert len(sim.run(["walk+reach-up"]).rows) == 1 + sim.steps_per_action
