@@ -4,7 +4,8 @@
   the articulated worker's 112 ``MOVE+CHANGE``; one action is 0.2 s).
 * **Observation** (float64, 11 values): time [s], x, y [m], cos and sin of the heading, forward and lateral
   flexion [rad], the robot's stop phase (0 running, 1 stop requested, 2 braking, 3 stopped), d_HR [m], v_R
-  [m/s] and the robot's path time [s], all at the action's last 50 ms step.
+  [m/s] and the robot's path time [s], all at the action's last 50 ms step; for the articulated worker 11 more:
+  its hip's drop [m] and the ten arm joints [rad].
 * **Reward**: the cell criterion's (``Criterion.reward``): for the paper's, 1/c_S after each action and -c_S at
   the horizon.
 * **terminated** when the episode reaches the unsafe set; **truncated** after ``actions_per_episode`` actions.
@@ -65,14 +66,18 @@ def observation_space(sim: Simulator) -> spaces.Box:
     v_max = float(reach * np.abs(lay.robot.velocity_limits).sum())
     low = np.array([0.0, fl.xmin, fl.ymin, -1.0, -1.0, 0.0, -lat, 0.0, 0.0, 0.0, 0.0])
     high = np.array([t_max, fl.xmax, fl.ymax, 1.0, 1.0, fwd, lat, 3.0, d_max, v_max, sim.phase + t_max])
+    if sim.layout.worker.articulated:  # its stance [m] and arm joints [rad] (human.reach's ranges lie within)
+        low = np.r_[low, -lay.body.height, np.full(10, -np.pi)]
+        high = np.r_[high, 0.5, np.full(10, np.pi)]
     return spaces.Box(low, high, dtype=np.float64)
 
 
-def observe(row: np.ndarray) -> np.ndarray:
-    """The observation of one metric row."""
+def observe(row: np.ndarray, limbs: bool = False) -> np.ndarray:
+    """The observation of one metric row (``limbs``: with the articulated worker's stance and arm joints)."""
     h = row[L.M_HEADING]
-    return np.array([row[L.M_T], row[L.M_X], row[L.M_Y], np.cos(h), np.sin(h), row[L.M_FWD], row[L.M_LAT],
-                     row[L.M_PHASE], row[L.M_D], row[L.M_V], row[L.M_TAU]], dtype=np.float64)
+    obs = np.array([row[L.M_T], row[L.M_X], row[L.M_Y], np.cos(h), np.sin(h), row[L.M_FWD], row[L.M_LAT],
+                    row[L.M_PHASE], row[L.M_D], row[L.M_V], row[L.M_TAU]], dtype=np.float64)
+    return np.r_[obs, row[L.M_DROP:L.M_DROP + 11]] if limbs else obs
 
 
 class CellEnv(gymnasium.Env):
@@ -84,6 +89,7 @@ class CellEnv(gymnasium.Env):
     def __init__(self, cell: str | Path | Cell = "baseline", criterion: str | None = None,
                  start: str | None = None):
         self.sim = _simulator(cell, criterion, start)
+        self._limbs = self.sim.layout.worker.articulated
         self.action_space = spaces.Discrete(self.sim.n_actions)
         self.observation_space = observation_space(self.sim)
         self.reward_of = self.sim.criterion.reward(self.sim.actions_per_episode)
@@ -95,7 +101,7 @@ class CellEnv(gymnasium.Env):
         self._state = self.sim.reset()
         self._played = 0
         row = self.sim.initial_metrics()
-        return observe(row), self._info(row, 0.0)
+        return observe(row, self._limbs), self._info(row, 0.0)
 
     def step(self, action):
         if not self.action_space.contains(action):
@@ -107,7 +113,7 @@ class CellEnv(gymnasium.Env):
         last = self._played >= self.sim.actions_per_episode
         reward, risk = self.reward_of(self.sim.measures(rows), last, unsafe)
         row = rows[-1]
-        return observe(row), float(reward), bool(unsafe), bool(last and not unsafe), self._info(row, risk)
+        return observe(row, self._limbs), float(reward), bool(unsafe), bool(last and not unsafe), self._info(row, risk)
 
     def _info(self, row: np.ndarray, risk: float) -> dict[str, Any]:
         seen = int(row[L.M_SEEN])
@@ -124,6 +130,7 @@ class CellVectorEnv(VectorEnv):
     def __init__(self, num_envs: int = 1, cell: str | Path | Cell = "baseline", criterion: str | None = None,
                  start: str | None = None):
         self.sim = _simulator(cell, criterion, start)
+        self._limbs = self.sim.layout.worker.articulated
         self.num_envs = int(num_envs)
         self.single_action_space = spaces.Discrete(self.sim.n_actions)
         self.action_space = spaces.MultiDiscrete(np.full(self.num_envs, self.sim.n_actions))
@@ -140,7 +147,7 @@ class CellVectorEnv(VectorEnv):
         self._played[:] = 0
         self._done[:] = False
         row = self.sim.initial_metrics()
-        obs = np.repeat(observe(row)[None, :], self.num_envs, axis=0)
+        obs = np.repeat(observe(row, self._limbs)[None, :], self.num_envs, axis=0)
         return obs, {}
 
     def step(self, actions):
@@ -164,12 +171,12 @@ class CellVectorEnv(VectorEnv):
         horizon = self.sim.actions_per_episode
         for i in range(self.num_envs):
             if restart[i]:  # next-step autoreset: this step only resets the copy
-                obs[i] = observe(row0)
+                obs[i] = observe(row0, self._limbs)
                 continue
             unsafe = self.sim.is_unsafe(self._states[i])
             last = self._played[i] >= horizon
             rewards[i] = self.reward_of(self.sim.measures(rows[i:i + 1]), bool(last), bool(unsafe))[0]
             terminated[i], truncated[i] = unsafe, last and not unsafe
-            obs[i] = observe(rows[i])
+            obs[i] = observe(rows[i], self._limbs)
         self._done = terminated | truncated
         return obs, rewards, terminated, truncated, {}
