@@ -27,6 +27,7 @@ from cellstress.robot.dynamics import point_dynamics, reflected_mass
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 from cellstress.sim.determinism import check_determinism
+from cellstress.sim.layout import pose_vector
 from cellstress.sim.scene import body_pose
 from cellstress.sim.simulator import Simulator
 
@@ -122,7 +123,7 @@ def test_head_contact_while_moving_is_unsafe_at_any_force():
 def test_body_regions():
     sim = Simulator("baseline")
     b = sim.layout.body
-    pose = body_pose(sim.layout, 0.0, 0.0, 0.0, 0.0, 0.0)  # upright at the origin, facing +x
+    pose = body_pose(sim.layout, pose_vector(0.0, 0.0, 0.0))  # upright at the origin, facing +x
 
     def region(part, p):
         return body_region(part, p, pose, b.height, b.upper_arm, b.forearm)

@@ -95,7 +95,7 @@ def test_worker_paths_follow_an_unlocked_door(unlocked):
     paths = unlocked.worker_paths(acts)
     for e in range(len(acts)):
         rows = unlocked.run(acts[e]).rows[1:]
-        assert np.array_equal(paths[e, : len(rows)], rows[:, [L.M_X, L.M_Y, L.M_HEADING, L.M_FWD, L.M_LAT]]), e
+        assert np.array_equal(paths[e, : len(rows)], rows[:, list(L.POSE_ROW)]), e
     assert paths[0, -1, 1] > DOOR_Y
 
 

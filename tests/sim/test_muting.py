@@ -84,5 +84,5 @@ def test_worker_paths_follow_the_pallet(long):
     paths = long.worker_paths(acts)
     for e in range(len(acts)):
         rows = long.run(acts[e]).rows[1:]
-        assert np.array_equal(paths[e, : len(rows)], rows[:, [L.M_X, L.M_Y, L.M_HEADING, L.M_FWD, L.M_LAT]])
+        assert np.array_equal(paths[e, : len(rows)], rows[:, list(L.POSE_ROW)])
     assert not long.layout.static_fences

@@ -42,10 +42,10 @@ def test_reach_points_are_inside_the_kernels_reach_volume():
     r = trace.record(trace.unsafe_row)
     args = (r.x, r.y, math.radians(r.heading_deg), math.radians(r.forward_flexion_deg),
             math.radians(r.lateral_flexion_deg))
-    pose = scene.body_pose(sim.layout, *args)
+    pose = scene.body_pose(sim.layout, L.pose_vector(*args))
     P = sim.params
     W = K.make_work(P)
-    K.human_pose(P, *args, W)
+    K.human_pose(P, L.pose_vector(*args), W)
     np.testing.assert_array_equal(pose.a, W.ha)
     np.testing.assert_array_equal(pose.shoulders, W.sh)
     n_near = K.near_fences(P, W, P.body[L.B_ARM_LEN] + 0.05)

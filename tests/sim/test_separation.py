@@ -30,7 +30,7 @@ def brute_force_d(sim: Simulator, row: np.ndarray) -> tuple[float, int, dict[tup
     body part) pair) for one metric row."""
     P = sim.params
     W = K.make_work(P)
-    K.human_pose(P, row[L.M_X], row[L.M_Y], row[L.M_HEADING], row[L.M_FWD], row[L.M_LAT], W)
+    K.human_pose(P, L.row_pose(row), W)
     n_near = int(K.near_fences(P, W, P.body[L.B_ARM_LEN] + 0.05))
     ra, rb = scene.robot_capsules(sim.layout, row[L.M_TAU])
     pairs: dict[tuple[int, int], float] = {}

@@ -9,7 +9,7 @@ import pytest
 from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
 
-POSE = [L.M_X, L.M_Y, L.M_HEADING, L.M_FWD, L.M_LAT]
+POSE = list(L.POSE_ROW)
 
 
 @pytest.mark.parametrize("cell", ["baseline", "s2-elbow-intrusion", "s3-fence-gap"])
@@ -19,7 +19,7 @@ def test_paths_are_the_simulated_poses(cell) -> None:
     acts = rng.integers(0, sim.n_actions, size=(300, sim.actions_per_episode))
     acts[:100] = rng.integers(0, 6, size=(100, sim.actions_per_episode))  # straight walks: into walls and table
     paths = sim.worker_paths(acts)
-    assert paths.shape == (300, sim.actions_per_episode * sim.steps_per_action, 5)
+    assert paths.shape == (300, sim.actions_per_episode * sim.steps_per_action, L.N_POSE)
     blocked = 0
     for e in range(len(acts)):
         rows = sim.run(acts[e]).rows[1:]  # (the first row is s0)

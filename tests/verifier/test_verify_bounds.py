@@ -22,9 +22,9 @@ def test_worker_within_its_radius_and_a_stride(cell) -> None:
     sim = Simulator(cell)
     P = sim.params
     rng = np.random.default_rng(1)
-    paths = sim.worker_paths(rng.integers(0, 30, size=(200, 8))).reshape(-1, 5)
+    paths = sim.worker_paths(rng.integers(0, 30, size=(200, 8))).reshape(-1, L.N_POSE)
     stride = P.body[L.B_WALK_SPEED] * sim.dt
-    steps = np.hypot(*np.diff(paths.reshape(200, -1, 5)[:, :, :2], axis=1).transpose(2, 0, 1))
+    steps = np.hypot(*np.diff(paths.reshape(200, -1, L.N_POSE)[:, :, :2], axis=1).transpose(2, 0, 1))
     assert steps.max() <= stride * (1 + 1e-12)
     radius = worker_radius(P.body, float(P.scal[L.C_REACH_H]))
     poses = paths[rng.choice(len(paths), 400, replace=False)]
