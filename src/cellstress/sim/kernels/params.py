@@ -112,6 +112,9 @@ class Work(NamedTuple):
     xphase: np.ndarray  # (nx,) stop phase
     ext0: np.ndarray  # (11,) the articulated worker's drop and arm joints when the action began (move_worker)
     ext1: np.ndarray  # (11,) the same for the pose being tried
+    ext2: np.ndarray  # (11,) an in-between pose of the sweep (sensing.path_blocked)
+    pa: np.ndarray  # (MAX_CAPSULES, 3) capsule ends at the sweep's previous in-between pose
+    pb: np.ndarray
 
 
 @njit(cache=True, error_model="numpy")
@@ -127,5 +130,6 @@ def make_work(P):
         np.zeros(3),
         np.zeros(2 * nc), np.zeros(2 * nc), np.full(2, np.nan), P.fences.copy(),
         np.zeros(njx), np.zeros(njx), np.zeros((njx, 3, 3)), np.zeros((njx, 3)), np.zeros((ncx, 3)),
-        np.zeros((ncx, 3)), np.zeros(nx), np.zeros(nx), np.zeros(nx), np.zeros(11), np.zeros(11),
+        np.zeros((ncx, 3)), np.zeros(nx), np.zeros(nx), np.zeros(nx), np.zeros(11), np.zeros(11), np.zeros(11),
+        np.zeros((MAX_CAPSULES, 3)), np.zeros((MAX_CAPSULES, 3)),
     )

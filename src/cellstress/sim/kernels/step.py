@@ -18,7 +18,7 @@ from cellstress.sim.kernels.fences import collect_near_fences
 from cellstress.sim.kernels.reach import reach_value_at
 from cellstress.sim.kernels.robot import live_path_time, other_robots, robot_at
 from cellstress.sim.kernels.scaling import command, commands_due
-from cellstress.sim.kernels.sensing import body_blocked, device_sees, feet_ok
+from cellstress.sim.kernels.sensing import body_blocked, device_sees, feet_ok, path_blocked
 from cellstress.sim.kernels.separation import separation
 from cellstress.sim.layout import (
     A_DIR,
@@ -326,7 +326,7 @@ def move_worker(P, state, action, h0, f0, l0, frac, W):
     lt = l0 + (l_to - l0) * frac
     ext = W.ext1
     if articulated:
-        blend_limbs(act, action, W.ext0, f, frac, ext)
+        blend_limbs(act, action, W.ext0, state, f, 1.0 / P.spa, ext)
         if state[S_DROP] < NO_WALK_BELOW:
             walks = 0.0  # crouched or kneeling: the feet stay
     nx, ny = x, y
@@ -340,11 +340,15 @@ def move_worker(P, state, action, h0, f0, l0, frac, W):
     # If the new pose would put a body part through a fence (or the articulated worker's arm into an obstacle),
     # the articulated worker first holds the arm that is in the way where it was; then either keeps the old
     # posture where it stands; if that fails too, stays put. (A loop, so that pose_body and body_blocked are
-    # inlined once: each copy cost seconds of a cold compile, in step_action and worker_paths alike.)
+    # inlined once: each copy cost seconds of a cold compile, in step_action and worker_paths alike.) The
+    # articulated worker's motion is checked along the way, not only where it ends (path_blocked).
     final = False
     for attempt in range(3):
-        pose_body(body, nx, ny, h, f, lt, ext, 0, ha, hb, hr, sh, tr)
-        blocked = body_blocked(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr)
+        if articulated:
+            blocked = path_blocked(body, fences, obs_verts, obs_poly, obs_box, state, nx, ny, h, f, lt, ext, W)
+        else:
+            pose_body(body, nx, ny, h, f, lt, ext, 0, ha, hb, hr, sh, tr)
+            blocked = body_blocked(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr)
         if blocked == 0:
             break
         if final:
@@ -368,19 +372,25 @@ def move_worker(P, state, action, h0, f0, l0, frac, W):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def blend_limbs(act, action, ext0, fwd, frac, ext):
-    """The articulated worker's stance and arm joints ``frac`` of the way from ext0 to the action's targets
-    (a target the action does not set stays where it was; hanging arms follow the trunk's flexion ``fwd``)."""
-    d_to = act[action, A_DROP] if act[action, A_SET_STANCE] != 0.0 else ext0[0]
-    ext[0] = ext0[0] + (d_to - ext0[0]) * frac
+def blend_limbs(act, action, ext0, state, fwd, per_step, ext):
+    """The articulated worker's stance and arm joints one time step on towards the action's targets: each from
+    where it is (the state) by ``per_step`` of the way from where the action began (ext0) to its target, so an
+    arm that was held moves on from where it was held, at its speed; a target the action does not set stays
+    where it was; hanging arms follow the trunk's flexion ``fwd``."""
     set_arms = act[action, A_SET_ARMS] != 0.0
-    for k in range(2):
-        for j in range(5):
-            i = 1 + 5 * k + j
-            to = act[action, A_Q0 + j] if set_arms else ext0[i]
-            if set_arms and j == 0 and act[action, A_HANG] != 0.0:
+    for i in range(11):
+        if i == 0:
+            to = act[action, A_DROP] if act[action, A_SET_STANCE] != 0.0 else ext0[0]
+        else:
+            to = act[action, A_Q0 + (i - 1) % 5] if set_arms else ext0[i]
+            if set_arms and (i - 1) % 5 == 0 and act[action, A_HANG] != 0.0:
                 to = fwd
-            ext[i] = ext0[i] + (to - ext0[i]) * frac
+        cur = state[S_DROP + i]
+        rate = abs(to - ext0[i]) * per_step
+        if i > 0 and set_arms and (i - 1) % 5 == 0 and act[action, A_HANG] != 0.0:
+            rate = max(rate, abs(fwd - state[S_FWD]))  # keep up with the trunk it hangs from
+        gap = to - cur
+        ext[i] = to if abs(gap) <= rate * (1.0 + 1e-12) else cur + (rate if gap > 0.0 else -rate)
 
 
 @njit(cache=True, error_model="numpy")
