@@ -120,12 +120,13 @@ STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
  S_DOOR0_REQ, S_DOOR1_REQ, S_DOOR2_REQ, S_DOOR3_REQ, S_DOOR0_OPEN, S_DOOR1_OPEN, S_DOOR2_OPEN,
  S_DOOR3_OPEN, S_XTSTOP1, S_XTSTOP2, S_XTSTOP3, S_SEP_ON, S_SEP_Q0, S_SEP_Q1, S_SEP_Q2, S_SEP_Q3, S_SEP_Q4,
  S_SEP_Q5, S_SEP_Q6, S_SEP_Q7, S_SEP_Q8, S_SEP_Q9, S_SEP_Q10, S_SEP_Q11, S_SEP_Q12, S_SEP_Q13, S_SEP_Q14, S_SEP_Q15,
- S_SEP_LOW, S_SEP_LOW_T, S_SEP_LOW_S, S_DROP, *_S_ARMS) = STATE.indices(
+ S_SEP_LOW, S_SEP_LOW_T, S_SEP_LOW_S, S_DROP, S_ARM0_Q0, S_ARM0_Q1, S_ARM0_Q2, S_ARM0_Q3, S_ARM0_Q4, S_ARM1_Q0,
+ S_ARM1_Q1, S_ARM1_Q2, S_ARM1_Q3, S_ARM1_Q4) = STATE.indices(
     "K", "X", "Y", "HEADING", "FWD", "LAT", "TSTOP", "TRIG_DEV", "TRIG_T", "UNSAFE", "ACTIONS", "LIVE", "A_T", "A_TAU",
     "A_SIG", "A_TGT", "TSLOW", "SLOW", "STOP_SEEN", "STOP_CLEAR", "SLOW_SEEN", "SLOW_CLEAR", "RESTARTS",
     *_DOOR_SLOTS, "XTSTOP1", "XTSTOP2", "XTSTOP3", "SEP_ON", "SEP_Q0", *_SEP_SLOTS, "SEP_LOW",
     "SEP_LOW_T", "SEP_LOW_S", "DROP", *_ARM_SLOTS)
-S_ARM = _S_ARMS[0]  # arm k's joint j: S_ARM + 5 k + j
+S_ARM = S_ARM0_Q0  # arm k's joint j: S_ARM + 5 k + j
 S_DOOR_REQ, S_DOOR_OPEN = S_DOOR0_REQ, S_DOOR0_OPEN  # door i's slots: these + i (the kernels index by door)
 NS = STATE.size
 S_XTSTOP = S_XTSTOP1  # robot r >= 1's stop is S_XTSTOP + r - 1 (the kernels loop over them)
@@ -168,11 +169,12 @@ ROW = VectorSpec("metric row (one per time step; row 0 of an episode is its star
 ))
 (M_T, M_X, M_Y, M_HEADING, M_FWD, M_LAT, M_D, M_V, M_SEEN, M_PHASE, M_LINK, M_PART, M_RX, M_RY, M_RZ, M_HX, M_HY, M_HZ,
  M_UNSAFE, M_TAU, M_ACTION, M_STEP, M_ROBOT, M_XTAU1, M_XTAU2, M_XTAU3, M_XPHASE1, M_XPHASE2, M_XPHASE3, M_DROP,
- *_M_ARMS) = ROW.indices(
+ M_ARM0_Q0, M_ARM0_Q1, M_ARM0_Q2, M_ARM0_Q3, M_ARM0_Q4, M_ARM1_Q0, M_ARM1_Q1, M_ARM1_Q2, M_ARM1_Q3,
+ M_ARM1_Q4) = ROW.indices(
     "T", "X", "Y", "HEADING", "FWD", "LAT", "D", "V", "SEEN", "PHASE", "LINK", "PART", "RX", "RY", "RZ", "HX", "HY",
     "HZ", "UNSAFE", "TAU", "ACTION", "STEP", "ROBOT", "XTAU1", "XTAU2", "XTAU3", "XPHASE1", "XPHASE2", "XPHASE3",
     "DROP", *_ARM_SLOTS)
-M_ARM = _M_ARMS[0]
+M_ARM = M_ARM0_Q0
 NM = ROW.size
 # A worker's pose as a vector (Simulator.worker_paths, worker_distances, scene.body_pose): x, y, heading, forward
 # and lateral flexion, then DROP and the ten arm joints; where a state and a row keep it.
