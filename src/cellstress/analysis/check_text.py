@@ -93,17 +93,12 @@ def _approach_lines(a, cycle: float) -> list[str]:
     return out + _reach_over_lines(a, cycle)
 
 
-def _panel_row(p, cycle: float) -> str:
+def _panel_row(pr, cycle: float) -> str:
     """'fence F panel P (..)-(..): top b m, hazard at a m, c = x m behind it; ISO 13857 Table 2 requires y m'."""
-    ro = p.reach_over
+    p, ro = pr.panel, pr.reach
     low = " (ISO 13857 4.4: lower than 1.4 m only with further protective measures)" if p.top < 1.4 else ""
-    if ro.required <= 0.0:
-        return f"  {p.name} {_xy(p.start)}-{_xy(p.end)}: top {p.top:.2f} m: nothing behind it is within reach{low}"
-    if math.isinf(ro.behind):
-        return (f"  {p.name} {_xy(p.start)}-{_xy(p.end)}: top {p.top:.2f} m: no part of the hazard zone within "
-                f"Table 2's distances behind it{low}: ok")
     lo, hi = ro.band
-    return (f"  {p.name} {_xy(p.start)}-{_xy(p.end)}: top {p.top:.2f} m, hazard at {ro.hazard_height:.2f} m, "
+    return (f"    {p.name} {_xy(p.start)}-{_xy(p.end)}: top {p.top:.2f} m, hazard at {ro.hazard_height:.2f} m, "
             f"c = {ro.behind:.3f} m behind it; ISO 13857 Table 2 requires {ro.required:.3f} m (a {lo * 1000:.0f}.."
             f"{hi * 1000:.0f} mm, b {p.top * 1000:.0f} mm): {_verdict(ro.ok)}{low}; {ro.robot_part} at "
             f"t = {ro.t:.2f} s (episode time, mod {cycle:.2f} s)")
@@ -115,7 +110,11 @@ def _reach_over_lines(a, cycle: float) -> list[str]:
     if not a.panels_at:
         return []
     fails = a.reach_over_fails
-    out = [f"  reach over the {len(a.panels_at)} fence panels the worker stands at unseen (ISO 13857 Table 2, "
-           f"high risk): {len(fails)} too close" + ("" if fails else ", the tightest:")]
-    rows = fails or (min(a.panels_at, key=lambda p: p.reach_over.behind - p.reach_over.required),)
-    return out + ["  " + _panel_row(p, cycle) for p in rows]
+    head = (f"  reach over the {len(a.panels_at)} fence panels the worker stands at unseen (ISO 13857 Table 2, "
+            "high risk): ")
+    if fails:
+        return [head + f"{len(fails)} too close"] + [_panel_row(p, cycle) for p in fails]
+    tight = min(a.panels_at, key=lambda p: p.reach.behind - p.reach.required)
+    if math.isinf(tight.reach.behind):
+        return [head + "no part of the hazard zone lies within the table's distances behind any of them: ok"]
+    return [head + "the tightest:", _panel_row(tight, cycle)]

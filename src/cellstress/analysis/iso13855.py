@@ -110,6 +110,14 @@ class FencePanel:
 
 
 @dataclass(frozen=True)
+class PanelReach:
+    """ISO 13857 Table 2 at a panel the worker stands at unseen, for the hazard zone on the panel's other side."""
+
+    panel: FencePanel
+    reach: ReachOver
+
+
+@dataclass(frozen=True)
 class ApproachCheck:
     """Closest reach to the hazard zone without being detected (ISO 13857 style)."""
 
@@ -126,12 +134,12 @@ class ApproachCheck:
     ok: bool
     robot: str = ""  # in a cell of several robots: the robot whose hazard zone it measures to
     guards: tuple[str, ...] = ()  # ... and the devices that stop that robot (the others do not count)
-    panels_at: tuple[FencePanel, ...] = ()  # panels of 1 m or more the worker stands at unseen (ISO 13857 Table 2)
+    panels_at: tuple[PanelReach, ...] = ()  # panels of 1 m or more the worker stands at unseen: ISO 13857 Table 2
 
     @property
-    def reach_over_fails(self) -> tuple[FencePanel, ...]:
+    def reach_over_fails(self) -> tuple[PanelReach, ...]:
         """The panels the worker stands at unseen whose top the hazard zone is too close behind (Table 2)."""
-        return tuple(p for p in self.panels_at if not p.reach_over.ok)
+        return tuple(p for p in self.panels_at if not p.reach.ok)
 
 
 @dataclass(frozen=True)
@@ -308,7 +316,7 @@ def _fence_panels(spec, zone: HazardZone, vol: HazardVolume) -> tuple[FencePanel
     return tuple(out)
 
 
-def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowance: float,
+def _approach_check(spec, layout, zone: HazardZone, vol: HazardVolume, panels, lean: float, allowance: float,
                     behind=None) -> ApproachCheck:
     """The undetected reach from the start point; with ``behind`` (a device's detection primitive), from every
     floor region next to that zone instead: where a worker who crossed it stands once it no longer sees them
@@ -396,7 +404,9 @@ def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowan
     at = panels_at(X[U], Y[U], [(p.start, p.end) for p in barriers], radius + h)
     return ApproachCheck((float(sx), float(sy)), bool(detected), float(U.sum() * h * h), lean, allowance,
                          m_scan, m_curtain, stand, float(best), where, bool(best >= allowance - 1e-9),
-                         panels_at=tuple(barriers[i] for i in at))
+                         panels_at=tuple(PanelReach(barriers[i], reach_over(barriers[i].start, barriers[i].end,
+                                                                            barriers[i].top, vol, side))
+                                         for i, side in at))
 
 
 @dataclass(frozen=True)
@@ -414,14 +424,15 @@ class RestartCheck:
         return self.behind.ok and not self.behind.reach_over_fails
 
 
-def _restart_checks(spec, layout, zone: HazardZone, panels, lean: float) -> tuple[RestartCheck, ...]:
+def _restart_checks(spec, layout, zone: HazardZone, vol: HazardVolume, panels, lean: float
+                    ) -> tuple[RestartCheck, ...]:
     out = []
     for d in spec.devices:
         if not isinstance(d, DeviceRecord) or d.restart == "manual":
             continue
         for prim in d.primitives():
             out.append(RestartCheck(d.name, d.clear_time,
-                                    _approach_check(spec, layout, zone, panels, lean, ARM_ALLOWANCE, prim)))
+                                    _approach_check(spec, layout, zone, vol, panels, lean, ARM_ALLOWANCE, prim)))
     return tuple(out)
 
 
@@ -434,18 +445,18 @@ def check_cell(cell: Cell | str | Path, layout=None) -> StaticCheck:
     spec = layout.cell.spec
     body = layout.params.body
     shoulder = float(body[L.B_HIP_Z] + body[L.B_SHOULDER_RISE])
-    zone = hazard_zone(layout)
-    panels = _fence_panels(spec, zone, hazard_volume(layout))
+    zone, vol = hazard_zone(layout), hazard_volume(layout)
+    panels = _fence_panels(spec, zone, vol)
     lean = lean_reach(layout)
     if len(spec.robots) > 1:
         devices, approaches = _per_robot(spec, layout, lean)
         approach, more = approaches[0], approaches[1:]
     else:
         devices = _device_checks(spec, zone)
-        approach, more = _approach_check(spec, layout, zone, panels, lean, ARM_ALLOWANCE), ()
+        approach, more = _approach_check(spec, layout, zone, vol, panels, lean, ARM_ALLOWANCE), ()
     return StaticCheck(spec.name, zone, devices, approach, panels, shoulder, float(body[L.B_ARM_LEN]),
                        episode_length(spec), spec.human.arrival == "fixed",
-                       _restart_checks(spec, layout, zone, panels, lean), more,
+                       _restart_checks(spec, layout, zone, vol, panels, lean), more,
                        tuple((p.name, float(p.trajectory.cycle)) for p in layout.robots) if more else (),
                        muting_checks(spec))
 
@@ -462,8 +473,8 @@ def _per_robot(spec, layout, lean: float) -> tuple[tuple[DeviceCheck, ...], list
         mine = tuple(d for d in spec.devices if stops_robot(d, rs.name))
         sr = spec.model_copy(update={"devices": mine})
         devices += _device_checks(sr, z, rs.name)
-        a = _approach_check(sr, layout, z, _fence_panels(spec, z, hazard_volume(layout, robot=r)), lean,
-                            ARM_ALLOWANCE)
+        v = hazard_volume(layout, robot=r)
+        a = _approach_check(sr, layout, z, v, _fence_panels(spec, z, v), lean, ARM_ALLOWANCE)
         approaches.append(replace(a, robot=rs.name, guards=tuple(d.name for d in mine)))
     return tuple(devices), approaches
 

@@ -58,6 +58,7 @@ class ReachOver:
     band: tuple[float, float]  # m, the rows a_i..a_i+1 of that band
     robot_part: str = ""  # the robot capsule there
     t: float = math.nan  # s, episode time of that pose (mod the cycle)
+    side: int = 0  # the worker's side of the panel (+1 left of start->end, -1 right; 0: both, the zone all round)
 
     @property
     def ok(self) -> bool:
@@ -120,15 +121,26 @@ BANDS = _bands()
 MAX_C = max(max(row) for row in T.TABLE_2.c_mm) / 1000.0  # m, the largest distance Table 2 asks
 
 
-def reach_over(p0, p1, top: float, vol: HazardVolume) -> ReachOver:
+def _signed(p0, p1, x, y):
+    """Signed distance of points from the line through p0-p1 (positive on its left, seen from p0 to p1)."""
+    dx, dy = p1[0] - p0[0], p1[1] - p0[1]
+    n = math.hypot(dx, dy)
+    return (dx * (y - p0[1]) - dy * (x - p0[0])) / n if n > 0.0 else np.zeros(np.shape(x))
+
+
+def reach_over(p0, p1, top: float, vol: HazardVolume, side: int = 0) -> ReachOver:
     """Table 2 behind the panel p0-p1 of height ``top`` [m]: over every row band, the horizontal distance from the
     panel to the zone's part in the band against the band's c; returned for the band with the least margin
-    (the first such band from the floor up on a tie)."""
+    (the first such band from the floor up on a tie). With ``side`` (the worker's side, as ``ReachOver.side``)
+    only the zone on the other side counts, and what reaches within a ball's radius of the panel's line."""
     b_mm = top * 1000.0
     if b_mm < T.NO_BARRIER_BELOW_MM:
-        return ReachOver(top, math.nan, math.inf, math.inf, (0.0, 0.0))
+        return ReachOver(top, math.nan, math.inf, math.inf, (0.0, 0.0), side=side)
     d = point_segment(vol.c[:, 0], vol.c[:, 1], p0[0], p0[1], p1[0], p1[1])[0]
-    near = np.flatnonzero(d - vol.r < MAX_C + 1e-6)  # farther balls meet every band's distance
+    keep = d - vol.r < MAX_C + 1e-6  # farther balls meet every band's distance
+    if side:
+        keep &= side * _signed(p0, p1, vol.c[:, 0], vol.c[:, 1]) <= vol.r
+    near = np.flatnonzero(keep)
     d, z, rad = d[near], vol.c[near, 2], vol.r[near]
     best: ReachOver | None = None
     for lo, hi, mid in BANDS:
@@ -138,24 +150,26 @@ def reach_over(p0, p1, top: float, vol: HazardVolume) -> ReachOver:
         gap = np.maximum(np.maximum(lo - z, z - hi), 0.0)  # vertical distance of each centre from the band
         cut = gap < rad
         if not cut.any():
-            row = ReachOver(top, math.nan, math.inf, need, (max(lo, 0.0), hi))
+            row = ReachOver(top, math.nan, math.inf, need, (max(lo, 0.0), hi), side=side)
         else:
             dist = d[cut] - np.sqrt(rad[cut] ** 2 - gap[cut] ** 2)
             k = int(np.argmin(dist))
             i = int(near[np.flatnonzero(cut)[k]])
             row = ReachOver(top, float(min(max(vol.c[i, 2], lo, 0.0), hi)), max(float(dist[k]), 0.0), need,
-                            (max(lo, 0.0), hi), vol.part_names[int(vol.part[i])], round(float(vol.t[i]), 3))
+                            (max(lo, 0.0), hi), vol.part_names[int(vol.part[i])], round(float(vol.t[i]), 3),
+                            side)
         if best is None or row.behind - row.required < best.behind - best.required - 1e-12:
             best = row
     if best is None:  # a top at 2.7 m or higher: nothing behind it can be reached over it
-        return ReachOver(top, math.nan, math.inf, 0.0, (0.0, 0.0))
+        return ReachOver(top, math.nan, math.inf, 0.0, (0.0, 0.0), side=side)
     return best
 
 
-def panels_at(xs: np.ndarray, ys: np.ndarray, panels, reach: float) -> list[int]:
-    """Indices of the panels (start, end pairs) a worker whose centre stands at one of the points (xs, ys) is at:
-    a panel within ``reach`` of a point whose nearest point on the panel is not a joint with another panel (at a
-    corner or a T-junction the worker is at the panel that meets them, not at the one that ends there)."""
+def panels_at(xs: np.ndarray, ys: np.ndarray, panels, reach: float) -> list[tuple[int, int]]:
+    """(index, side) of the panels (start, end pairs) a worker whose centre stands at one of the points (xs, ys)
+    is at: a panel within ``reach`` of a point whose nearest point on the panel is not a joint with another
+    panel (at a corner or a T-junction the worker is at the panel that meets them, not at the one that ends
+    there); side as ``ReachOver.side`` (0 where the worker stands on both sides, or in line with the panel)."""
     segs = [(np.asarray(a, float), np.asarray(b, float)) for a, b in panels]
 
     def joined(p, i: int) -> bool:
@@ -170,5 +184,7 @@ def panels_at(xs: np.ndarray, ys: np.ndarray, panels, reach: float) -> list[int]
             if near.any() and joined(end, i):
                 near &= np.hypot(qx - end[0], qy - end[1]) > 1e-9
         if near.any():
-            out.append(i)
+            sd = _signed(a, b, xs[near], ys[near])
+            left, right = bool((sd > 1e-9).any()), bool((sd < -1e-9).any())
+            out.append((i, 1 if left and not right else -1 if right and not left else 0))
     return out
