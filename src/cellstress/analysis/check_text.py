@@ -5,6 +5,9 @@ from __future__ import annotations
 import math
 
 from cellstress.analysis.hazard_zone import Closest
+from cellstress.core.iso13857 import MIN_HIGH_RISK_STRUCTURE_MM
+
+LOW_HIGH_RISK = MIN_HIGH_RISK_STRUCTURE_MM / 1000.0  # m
 
 
 def _xy(p) -> str:
@@ -96,11 +99,10 @@ def _approach_lines(a, cycle: float) -> list[str]:
 def _panel_row(pr, cycle: float) -> str:
     """'fence F panel P (..)-(..): top b m, hazard at a m, c = x m behind it; ISO 13857 Table 2 requires y m'."""
     p, ro = pr.panel, pr.reach
-    low = " (ISO 13857 4.4: lower than 1.4 m only with further protective measures)" if p.top < 1.4 else ""
     lo, hi = ro.band
     return (f"    {p.name} {_xy(p.start)}-{_xy(p.end)}: top {p.top:.2f} m, hazard at {ro.hazard_height:.2f} m, "
             f"c = {ro.behind:.3f} m behind it; ISO 13857 Table 2 requires {ro.required:.3f} m (a {lo * 1000:.0f}.."
-            f"{hi * 1000:.0f} mm, b {p.top * 1000:.0f} mm): {_verdict(ro.ok)}{low}; {ro.robot_part} at "
+            f"{hi * 1000:.0f} mm, b {p.top * 1000:.0f} mm): {_verdict(ro.ok)}; {ro.robot_part} at "
             f"t = {ro.t:.2f} s (episode time, mod {cycle:.2f} s)")
 
 
@@ -110,8 +112,10 @@ def _reach_over_lines(a, cycle: float) -> list[str]:
     if not a.panels_at:
         return []
     fails = a.reach_over_fails
+    low = sum(p.panel.top < LOW_HIGH_RISK for p in a.panels_at)
     head = (f"  reach over the {len(a.panels_at)} fence panels the worker stands at unseen (ISO 13857 Table 2, "
-            "high risk): ")
+            "high risk" + (f"; {low} lower than 1.4 m, which 4.4 allows only with further protective measures"
+                           if low else "") + "): ")
     if fails:
         return [head + f"{len(fails)} too close"] + [_panel_row(p, cycle) for p in fails]
     tight = min(a.panels_at, key=lambda p: p.reach.behind - p.reach.required)

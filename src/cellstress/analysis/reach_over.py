@@ -14,7 +14,8 @@ disc it cuts at the band's nearer edge (its whole radius where its centre lies i
 
 **Between the rows** the standard takes the value giving the greater safety (``iso13857.reach_over_distance``):
 every part of the zone between rows a_i and a_i+1 must keep the larger of the two rows' distances; parts below
-the floor count as row 0, parts at 2.7 m and above are out of reach (clause 4.2.1: the top row is zero).
+the floor count as in the lowest band (0..200 mm), parts at 2.7 m and above are out of reach (clause 4.2.1: the top
+row is zero).
 """
 
 from __future__ import annotations
@@ -62,7 +63,8 @@ class ReachOver:
 
     @property
     def ok(self) -> bool:
-        return self.behind >= self.required - 1e-9
+        """Table 2 is met (never below 1 m: no distance is enough behind what is no barrier)."""
+        return math.isfinite(self.required) and self.behind >= self.required - 1e-9
 
 
 def hazard_volume(layout, sample_dt: float = SAMPLE_DT, robot: int | None = None) -> HazardVolume:
