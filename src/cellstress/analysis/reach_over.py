@@ -173,10 +173,13 @@ def panels_at(xs: np.ndarray, ys: np.ndarray, panels, reach: float) -> list[tupl
     panel (at a corner or a T-junction the worker is at the panel that meets them, not at the one that ends
     there); side as ``ReachOver.side`` (0 where the worker stands on both sides, or in line with the panel)."""
     segs = [(np.asarray(a, float), np.asarray(b, float)) for a, b in panels]
+    A = np.array([a for a, _ in segs]).reshape(-1, 2)
+    B = np.array([b for _, b in segs]).reshape(-1, 2)
 
     def joined(p, i: int) -> bool:
-        return any(point_segment(p[0], p[1], a[0], a[1], b[0], b[1])[0] < 1e-6
-                   for j, (a, b) in enumerate(segs) if j != i)
+        d = point_segment(p[0], p[1], A[:, 0], A[:, 1], B[:, 0], B[:, 1])[0]
+        d[i] = np.inf
+        return bool((d < 1e-6).any())
 
     out = []
     for i, (a, b) in enumerate(segs):
