@@ -33,13 +33,14 @@ def test_reach_over_a_2m_fence_is_impossible(results):
     r = results["baseline"][1]
     assert r.shoulder_height == pytest.approx(0.818 * 1.78)  # 1.456 m, Winter's shoulder height
     assert r.arm_length == pytest.approx(0.30 + 0.31 + 0.18)  # 0.79 m
-    # straight up the fingertip gets 2.246 m high, only 0.246 m over the 2.0 m top ...
+    # straight up the fingertip gets 2.246 m high, only 0.246 m over the 2.0 m top
     assert r.shoulder_height + r.arm_length - 2.0 == pytest.approx(0.24604, abs=1e-5)
-    # ... and the zone is at least 0.7 m behind every panel, so any path over a top exceeds the 0.85 m allowance
+    # ISO 13857 Table 2 behind a 2.0 m top: nothing up to a = 1.4 m, 0.5 m from 1.4 m up (the zone's top reaches
+    # into that band); the zone is at least 0.7 m behind every panel
     for p in r.fences:
-        assert p.closed
-        assert p.over_top == pytest.approx(2.0 - r.shoulder_height + p.to_hazard)
-        assert p.to_hazard >= 0.7 and p.over_top > 1.2
+        assert p.closed and p.reach_over.ok and p.to_hazard >= 0.7
+        assert p.reach_over.required in (0.5, 0.0) and p.reach_over.behind >= 0.7
+    assert {(p.panel.fence, p.panel.panel) for p in r.approach.panels_at} == {(1, 1), (1, 2), (2, 1), (2, 2)}
 
 
 def _lean_by_hand(height=1.78, fwd_deg=55.0, lat_deg=35.0):

@@ -5,6 +5,9 @@ from __future__ import annotations
 import math
 
 from cellstress.analysis.hazard_zone import Closest
+from cellstress.core.iso13857 import MIN_HIGH_RISK_STRUCTURE_MM
+
+LOW_HIGH_RISK = MIN_HIGH_RISK_STRUCTURE_MM / 1000.0  # m
 
 
 def _xy(p) -> str:
@@ -48,14 +51,12 @@ def check_lines(r) -> list[str]:
         if d.note:
             out.append(f"  {d.note}")
     closed = [p for p in r.fences if p.closed]
-    open_ = [p for p in r.fences if not p.closed]
-    if closed:
-        p = min(closed, key=lambda q: q.over_top)
-        out.append(f"fences: {len(closed)} of {len(r.fences)} panels close the way; nearest reach over a top: "
-                   f"{p.top:.2f} - {r.shoulder_height:.3f} (shoulder) + {p.to_hazard:.3f} = {p.over_top:.3f} m "
-                   f">= {r.approach.arm_allowance:.2f} m ({_xy(p.start)}-{_xy(p.end)})")
-    for p in open_:
-        out.append(f"  panel {_xy(p.start)}-{_xy(p.end)} counts as open: {p.reason}")
+    if r.fences:
+        out.append(f"fences: {len(closed)} of {len(r.fences)} panels close the way (lower than 1 m, raised off the "
+                   "floor, or not meeting ISO 13857 Table 2 behind its top: open)")
+    for p in r.fences:
+        if not p.closed:
+            out.append(f"  {p.name} {_xy(p.start)}-{_xy(p.end)} counts as open: {p.reason}")
     for a in (r.approach, *r.robot_approaches):
         out += _approach_lines(a, cycles.get(a.robot, z.cycle))
     for rc in r.restarts:
@@ -63,11 +64,12 @@ def check_lines(r) -> list[str]:
         out.append(f"{rc.device}: automatic restart after {rc.clear_time:g} s clear; a worker who crossed it stands "
                    f"unseen on {b.undetected_area:.1f} m^2 next to it")
         if b.where is None:
-            out.append(f"  from there the hazard zone cannot be reached: {_verdict(rc.ok)}")
+            out.append(f"  from there the hazard zone cannot be reached: {_verdict(b.ok)}")
         else:
             out.append(f"  closest: stand at {_xy(b.stand)}, shoulder at {_xy(b.where.point)}, arm path "
-                       f"{b.distance:.3f} m >= {b.arm_allowance:.2f} m? {_verdict(rc.ok)}{_where(b.where, z.cycle)}"
-                       + ("" if rc.ok else ": the robot restarts while the worker stands unseen within reach"))
+                       f"{b.distance:.3f} m >= {b.arm_allowance:.2f} m? {_verdict(b.ok)}{_where(b.where, z.cycle)}"
+                       + ("" if b.ok else ": the robot restarts while the worker stands unseen within reach"))
+        out += _reach_over_lines(b, z.cycle)
     out += [m.line() for m in r.mutings]
     fails = r.failures()
     out.append("result: pass" if not fails else f"result: FAIL ({', '.join(fails)})")
@@ -91,4 +93,32 @@ def _approach_lines(a, cycle: float) -> list[str]:
     else:
         out.append(f"  closest: stand at {_xy(a.stand)}, shoulder at {_xy(a.where.point)}, arm path "
                    f"{a.distance:.3f} m >= {a.arm_allowance:.2f} m? {_verdict(a.ok)}{_where(a.where, cycle)}")
-    return out
+    return out + _reach_over_lines(a, cycle)
+
+
+def _panel_row(pr, cycle: float) -> str:
+    """'fence F panel P (..)-(..): top b m, hazard at a m, c = x m behind it; ISO 13857 Table 2 requires y m'."""
+    p, ro = pr.panel, pr.reach
+    lo, hi = ro.band
+    return (f"    {p.name} {_xy(p.start)}-{_xy(p.end)}: top {p.top:.2f} m, hazard at {ro.hazard_height:.2f} m, "
+            f"c = {ro.behind:.3f} m behind it; ISO 13857 Table 2 requires {ro.required:.3f} m (a {lo * 1000:.0f}.."
+            f"{hi * 1000:.0f} mm, b {p.top * 1000:.0f} mm): {_verdict(ro.ok)}; {ro.robot_part} at "
+            f"t = {ro.t:.2f} s (episode time, mod {cycle:.2f} s)")
+
+
+def _reach_over_lines(a, cycle: float) -> list[str]:
+    """ISO 13857 Table 2 at the panels the worker stands at unseen: a row per panel that fails it, else the one
+    with the least margin."""
+    if not a.panels_at:
+        return []
+    fails = a.reach_over_fails
+    low = sum(p.panel.top < LOW_HIGH_RISK for p in a.panels_at)
+    head = (f"  reach over the {len(a.panels_at)} fence panels the worker stands at unseen (ISO 13857 Table 2, "
+            "high risk" + (f"; {low} lower than 1.4 m, which 4.4 allows only with further protective measures"
+                           if low else "") + "): ")
+    if fails:
+        return [head + f"{len(fails)} too close"] + [_panel_row(p, cycle) for p in fails]
+    tight = min(a.panels_at, key=lambda p: p.reach.behind - p.reach.required)
+    if math.isinf(tight.reach.behind):
+        return [head + "no part of the hazard zone lies within the table's distances behind any of them: ok"]
+    return [head + "the tightest:", _panel_row(tight, cycle)]

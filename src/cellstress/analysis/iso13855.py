@@ -18,8 +18,12 @@ The reasoning behind every number is in docs/cells.md. In short:
   reach ISO 13857's 850 mm around fence ends, over the table and over scanner fields (a scanner sees only its
   plane). The check fails if the hazard zone is within that reach. Reaching *through* a curtain is the
   curtain's own check (its C = 850 mm is exactly that allowance), so curtains close the way here.
-  Fences lower than 1 m (ISO 13857), raised off the floor, or so close to the hazard zone that the arm could
-  reach over their top are treated as open.
+* **Reach over the fences** (ISO 13857:2019 Table 2, high risk: ``analysis.reach_over``). Behind every panel
+  the worker can stand at unseen, the hazard zone at height a must lie the table's c(a, b) behind the panel's
+  top b; the check fails (``reach-over``) where it does not. A panel lower than 1 m is no barrier (clause
+  4.2.2), one raised off the floor lets the arm under it (ISO 13857's tables for reaching under, Tables 6 and
+  7, are for the lower limbs and not in ``core.iso13857``), and one that does not meet Table 2 lets it over:
+  these three count as open in the undetected reach.
 """
 
 from __future__ import annotations
@@ -44,7 +48,9 @@ from cellstress.analysis.plane import (
     points_in_polygon,
     rasterise_zone,
 )
+from cellstress.analysis.reach_over import HazardVolume, ReachOver, hazard_volume, panels_at, reach_over
 from cellstress.cell.load import Cell, load_cell
+from cellstress.core.iso13857 import NO_BARRIER_BELOW_MM
 from cellstress.core.records import DoorLeaf, ScanPlane, VerticalField
 from cellstress.devices.base import DeviceRecord, stops_robot
 from cellstress.human.body import WALK_BLOCK_HEIGHT
@@ -54,7 +60,7 @@ from cellstress.sim.build import build_layout
 
 GRID = 0.05  # m, flood-fill grid
 ARM_ALLOWANCE = 0.85  # m, ISO 13857 reach of the arm up to the armpit (also ISO 13855's C for body detection)
-LOW_FENCE = 1.0  # m, ISO 13857: a structure lower than this is no barrier to reaching over
+LOW_FENCE = NO_BARRIER_BELOW_MM / 1000.0  # m, ISO 13857 4.2.2: a structure lower than this is no barrier
 
 
 # ---- records ----------------------------------------------------------------------------------------------
@@ -85,14 +91,30 @@ class DeviceCheck:
 
 @dataclass(frozen=True)
 class FencePanel:
+    """One straight panel of a fence: ISO 13857 Table 2 behind it, and whether it closes the way."""
+
     start: tuple[float, float]
     end: tuple[float, float]
     top: float
     bottom: float
-    to_hazard: float  # m, horizontal distance to the hazard zone
-    over_top: float  # m, lower bound of an arm path from a standing shoulder over the top to the zone
+    to_hazard: float  # m, horizontal distance to the hazard zone's floor footprint
     closed: bool  # blocks leaning and reaching in the undetected-reach check
     reason: str
+    fence: int = 0  # which fence of the cell (from 1)
+    panel: int = 0  # which panel of that fence (from 1)
+    reach_over: ReachOver | None = None  # ISO 13857 Table 2 behind it (None: lower than 1 m, no barrier)
+
+    @property
+    def name(self) -> str:
+        return f"fence {self.fence} panel {self.panel}"
+
+
+@dataclass(frozen=True)
+class PanelReach:
+    """ISO 13857 Table 2 at a panel the worker stands at unseen, for the hazard zone on the panel's other side."""
+
+    panel: FencePanel
+    reach: ReachOver
 
 
 @dataclass(frozen=True)
@@ -112,6 +134,12 @@ class ApproachCheck:
     ok: bool
     robot: str = ""  # in a cell of several robots: the robot whose hazard zone it measures to
     guards: tuple[str, ...] = ()  # ... and the devices that stop that robot (the others do not count)
+    panels_at: tuple[PanelReach, ...] = ()  # panels of 1 m or more the worker stands at unseen: ISO 13857 Table 2
+
+    @property
+    def reach_over_fails(self) -> tuple[PanelReach, ...]:
+        """The panels the worker stands at unseen whose top the hazard zone is too close behind (Table 2)."""
+        return tuple(p for p in self.panels_at if not p.reach.ok)
 
 
 @dataclass(frozen=True)
@@ -132,16 +160,18 @@ class StaticCheck:
 
     @property
     def ok(self) -> bool:
-        return (all(d.ok for d in self.devices) and self.approach.ok
-                and all(r.ok for r in self.restarts + self.mutings) and all(a.ok for a in self.robot_approaches))
+        return not self.failures()
 
     def failures(self) -> list[str]:
-        """Names of the failed checks: device names, 'undetected-reach', 'DEVICE-restart', 'DEVICE-muting' (in a
-        cell of several robots, with ':ROBOT' after a device's or the reach check's name)."""
+        """Names of the failed checks: device names, 'undetected-reach', 'reach-over' (ISO 13857 Table 2),
+        'DEVICE-restart', 'DEVICE-muting' (in a cell of several robots, with ':ROBOT' after a device's or the
+        reach checks' names)."""
         out = [d.device + (f":{d.robot}" if d.robot else "") for d in self.devices if not d.ok]
         for a in (self.approach, *self.robot_approaches):
             if not a.ok:
                 out.append("undetected-reach" + (f":{a.robot}" if a.robot else ""))
+            if a.reach_over_fails:
+                out.append("reach-over" + (f":{a.robot}" if a.robot else ""))
         out += [f"{r.device}-restart" for r in self.restarts if not r.ok]
         out += [f"{m.device}-muting" for m in self.mutings if not m.ok]
         return out
@@ -266,27 +296,27 @@ def _entry_segments(prim, covers) -> list[tuple[tuple[float, float], tuple[float
     raise TypeError(f"unknown detection primitive {type(prim).__name__}")
 
 
-def _fence_panels(spec, zone: HazardZone, shoulder: float, allowance: float) -> tuple[FencePanel, ...]:
+def _fence_panels(spec, zone: HazardZone, vol: HazardVolume) -> tuple[FencePanel, ...]:
     out = []
-    for f in spec.fences:
-        for a, b in zip(f.points, f.points[1:], strict=False):
+    for i, f in enumerate(spec.fences, 1):
+        for j, (a, b) in enumerate(zip(f.points, f.points[1:], strict=False), 1):
             dist = segment_to_zone(a, b, zone)[0]
-            over = max(f.top - shoulder, 0.0) + dist
-            if f.bottom > 0.0:
+            ro = reach_over(a, b, f.top, vol) if f.top >= LOW_FENCE else None
+            if ro is None:
+                closed, why = False, f"top {f.top:.2f} m < {LOW_FENCE:.1f} m (ISO 13857 4.2.2: no barrier)"
+            elif f.bottom > 0.0:
                 closed, why = False, f"raised {f.bottom:.2f} m off the floor: the arm may pass under"
-            elif f.top < LOW_FENCE:
-                closed, why = False, f"top {f.top:.2f} m < {LOW_FENCE:.1f} m (ISO 13857: no barrier)"
-            elif over < allowance:
-                closed, why = False, (f"reach over the top {over:.2f} m < {allowance:.2f} m "
-                                      f"({f.top:.2f} - {shoulder:.3f} up + {dist:.2f} across)")
+            elif not ro.ok:
+                closed, why = False, (f"the hazard zone at {ro.hazard_height:.2f} m is {ro.behind:.3f} m behind its "
+                                      f"{f.top:.2f} m top, ISO 13857 Table 2 requires {ro.required:.3f} m: "
+                                      "the arm may reach over")
             else:
-                closed, why = True, (f"reach over the top >= {f.top:.2f} - {shoulder:.3f} + {dist:.2f} = "
-                                     f"{over:.2f} m >= {allowance:.2f} m")
-            out.append(FencePanel(tuple(a), tuple(b), f.top, f.bottom, dist, over, closed, why))
+                closed, why = True, "ISO 13857 Table 2 met"
+            out.append(FencePanel(tuple(a), tuple(b), f.top, f.bottom, dist, closed, why, i, j, ro))
     return tuple(out)
 
 
-def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowance: float,
+def _approach_check(spec, layout, zone: HazardZone, vol: HazardVolume, panels, lean: float, allowance: float,
                     behind=None) -> ApproachCheck:
     """The undetected reach from the start point; with ``behind`` (a device's detection primitive), from every
     floor region next to that zone instead: where a worker who crossed it stands once it no longer sees them
@@ -369,8 +399,14 @@ def _approach_check(spec, layout, zone: HazardZone, panels, lean: float, allowan
         f = (dd - zone.r[k]) / dd if dd > 0 else 0.0
         hx, hy = px + (float(hp[1]) - px) * f, py + (float(hp[2]) - py) * f
         where = closest_on_zone(zone, (px, py), (hx, hy), k)
+    # the panels the worker stands at unseen: a walk-blocking panel keeps the centre a body radius away
+    barriers = [p for p in panels if p.reach_over is not None]
+    at = panels_at(X[U], Y[U], [(p.start, p.end) for p in barriers], radius + h)
     return ApproachCheck((float(sx), float(sy)), bool(detected), float(U.sum() * h * h), lean, allowance,
-                         m_scan, m_curtain, stand, float(best), where, bool(best >= allowance - 1e-9))
+                         m_scan, m_curtain, stand, float(best), where, bool(best >= allowance - 1e-9),
+                         panels_at=tuple(PanelReach(barriers[i], reach_over(barriers[i].start, barriers[i].end,
+                                                                            barriers[i].top, vol, side))
+                                         for i, side in at))
 
 
 @dataclass(frozen=True)
@@ -385,17 +421,18 @@ class RestartCheck:
 
     @property
     def ok(self) -> bool:
-        return self.behind.ok
+        return self.behind.ok and not self.behind.reach_over_fails
 
 
-def _restart_checks(spec, layout, zone: HazardZone, panels, lean: float) -> tuple[RestartCheck, ...]:
+def _restart_checks(spec, layout, zone: HazardZone, vol: HazardVolume, panels, lean: float
+                    ) -> tuple[RestartCheck, ...]:
     out = []
     for d in spec.devices:
         if not isinstance(d, DeviceRecord) or d.restart == "manual":
             continue
         for prim in d.primitives():
             out.append(RestartCheck(d.name, d.clear_time,
-                                    _approach_check(spec, layout, zone, panels, lean, ARM_ALLOWANCE, prim)))
+                                    _approach_check(spec, layout, zone, vol, panels, lean, ARM_ALLOWANCE, prim)))
     return tuple(out)
 
 
@@ -408,23 +445,23 @@ def check_cell(cell: Cell | str | Path, layout=None) -> StaticCheck:
     spec = layout.cell.spec
     body = layout.params.body
     shoulder = float(body[L.B_HIP_Z] + body[L.B_SHOULDER_RISE])
-    zone = hazard_zone(layout)
-    panels = _fence_panels(spec, zone, shoulder, ARM_ALLOWANCE)
+    zone, vol = hazard_zone(layout), hazard_volume(layout)
+    panels = _fence_panels(spec, zone, vol)
     lean = lean_reach(layout)
     if len(spec.robots) > 1:
-        devices, approaches = _per_robot(spec, layout, shoulder, lean)
+        devices, approaches = _per_robot(spec, layout, lean)
         approach, more = approaches[0], approaches[1:]
     else:
         devices = _device_checks(spec, zone)
-        approach, more = _approach_check(spec, layout, zone, panels, lean, ARM_ALLOWANCE), ()
+        approach, more = _approach_check(spec, layout, zone, vol, panels, lean, ARM_ALLOWANCE), ()
     return StaticCheck(spec.name, zone, devices, approach, panels, shoulder, float(body[L.B_ARM_LEN]),
                        episode_length(spec), spec.human.arrival == "fixed",
-                       _restart_checks(spec, layout, zone, panels, lean), more,
+                       _restart_checks(spec, layout, zone, vol, panels, lean), more,
                        tuple((p.name, float(p.trajectory.cycle)) for p in layout.robots) if more else (),
                        muting_checks(spec))
 
 
-def _per_robot(spec, layout, shoulder: float, lean: float) -> tuple[tuple[DeviceCheck, ...], list[ApproachCheck]]:
+def _per_robot(spec, layout, lean: float) -> tuple[tuple[DeviceCheck, ...], list[ApproachCheck]]:
     """A cell of several robots, robot by robot: each device that stops the robot, with the robot's stopping
     time, measured to the robot's own hazard zone; and the undetected reach to that zone, where a device that
     does not stop the robot is no protection (the worker walks through it: a curtain wired to robot a only
@@ -436,7 +473,8 @@ def _per_robot(spec, layout, shoulder: float, lean: float) -> tuple[tuple[Device
         mine = tuple(d for d in spec.devices if stops_robot(d, rs.name))
         sr = spec.model_copy(update={"devices": mine})
         devices += _device_checks(sr, z, rs.name)
-        a = _approach_check(sr, layout, z, _fence_panels(spec, z, shoulder, ARM_ALLOWANCE), lean, ARM_ALLOWANCE)
+        v = hazard_volume(layout, robot=r)
+        a = _approach_check(sr, layout, z, v, _fence_panels(spec, z, v), lean, ARM_ALLOWANCE)
         approaches.append(replace(a, robot=rs.name, guards=tuple(d.name for d in mine)))
     return tuple(devices), approaches
 
