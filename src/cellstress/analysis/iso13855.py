@@ -249,9 +249,8 @@ def _device_checks(spec, zone: HazardZone, robot: str = "") -> tuple[DeviceCheck
         entries, actual, where, ep = _entries_to_zone(d.primitives(), covers, zone, t_ep)
         required = iso.S / 1000.0
         note = ""
-        own = getattr(d, "static_check", None)  # a device kind's own part (a guard door, speed and separation)
-        if own is not None:
-            actual, note = own(actual, stop)
+        if isinstance(d, DeviceRecord):  # a device kind's own part (a guard door, speed and separation)
+            actual, note = d.static_check(actual, stop)
         out.append(DeviceCheck(d.name, d.type, d.response_time, stop, iso.T, iso.K, iso.C, required,
                                actual, bool(actual >= required - 1e-9), iso.formula, where,
                                tuple(entries), ep, any(isinstance(p, ScanPlane) for p in d.primitives()), robot,

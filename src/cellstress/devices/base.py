@@ -58,6 +58,13 @@ class DeviceRecord(Record):
         """ISO 13855 distance of the device's warning field (a channel that reduces the speed), if it has one."""
         return None
 
+    def static_check(self, distance: float, stopping_time: float) -> tuple[float, str]:
+        """This kind's own part of the static check (``analysis.iso13855``): the separation it guarantees given
+        the ``distance`` its detection zone keeps from the hazard zone, and a note for the check's row. By
+        default the zone's distance itself, without a note; a guard door credits its opening time, a speed and
+        separation monitor its configured protective separation."""
+        return distance, ""
+
 
 def stops_of(device) -> tuple[str, ...] | None:
     """The robot names a device's stop is limited to (``DeviceRecord.stops``); None: every robot (also for a
