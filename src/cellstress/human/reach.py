@@ -249,8 +249,12 @@ class ReachField:
 
 
 def _build(lengths: tuple[float, float, float], spacing: float) -> ReachField:
-    from scipy import ndimage
+    origin = _grid(lengths, spacing)[1]
+    return ReachField(_signed_distance(_occupied(lengths, spacing), spacing), origin, spacing, float(sum(lengths)))
 
+
+def _occupied(lengths: tuple[float, float, float], spacing: float) -> np.ndarray:
+    """The voxels (of the field's grid) the arm's segments cross at the joint samples, bool (n, n, n)."""
     reach = float(sum(lengths))
     n, origin = _grid(lengths, spacing)
     occupied = np.zeros((n, n, n), dtype=np.bool_)
@@ -262,13 +266,19 @@ def _build(lengths: tuple[float, float, float], spacing: float) -> ReachField:
     _rasterise(occupied, origin, spacing, lengths_arr, *_joint_axes((6.0, 6.0, 10.0, 10.0, 10.0)))
     fine = np.rad2deg(spacing / reach) * 0.9
     _rasterise(occupied, origin, spacing, lengths_arr, *_joint_axes((fine, fine, 200.0, 200.0, 200.0)))
+    return occupied
+
+
+def _signed_distance(occupied: np.ndarray, spacing: float) -> np.ndarray:
+    """The rasterised arm closed (pinholes between samples), filled, and its signed distance, float32."""
+    from scipy import ndimage
+
     occupied = ndimage.binary_closing(occupied, structure=np.ones((3, 3, 3)), iterations=1)
     occupied = ndimage.binary_fill_holes(occupied)
     outside = ndimage.distance_transform_edt(~occupied, sampling=spacing)
     inside = ndimage.distance_transform_edt(occupied, sampling=spacing)
     # Voxel centres are samples of a surface that lies half a voxel beyond the outermost occupied centre.
-    sdf = np.where(occupied, -(inside - 0.5 * spacing), outside - 0.5 * spacing).astype(np.float32)
-    return ReachField(sdf, origin, spacing, reach)
+    return np.where(occupied, -(inside - 0.5 * spacing), outside - 0.5 * spacing).astype(np.float32)
 
 
 def _grid(lengths: tuple[float, float, float], spacing: float) -> tuple[int, float]:
