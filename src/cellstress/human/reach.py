@@ -115,9 +115,17 @@ def _cos_sin(angles, sign):
 
 
 @njit(cache=True)
-def _rasterise_part(grid, origin, h, lengths, first, a0, a1, a2, a3, a4):
+def _copy3(src, dst):
+    """dst[:, :] = src for 3x3 arrays (a slice assignment would compile numba's shape checks: seconds)."""
+    for r in range(3):
+        for c in range(3):
+            dst[r, c] = src[r, c]
+
+
+@njit(cache=True)
+def _rasterise_part(grid, origin, h, lengths, start, stride, a0, a1, a2, a3, a4):
     """Mark every voxel the arm's three segments cross, for every combination of the five joints' samples,
-    the first joint's taken from ``first`` (indices into a0). The arm's own forward kinematics
+    the first joint's every ``stride``-th from ``start``. The arm's own forward kinematics
     (arm_points_into) computed joint by joint with the same operations in the same order, so every point is
     bit for bit the same: the elbow does not depend on the last three joints (rotation about the upper arm's
     axis leaves it in place) and the wrist not on the last, so the upper arm is marked once per pair of the
@@ -132,7 +140,7 @@ def _rasterise_part(grid, origin, h, lengths, first, a0, a1, a2, a3, a4):
     r01 = np.empty((3, 3))
     r012 = np.empty((3, 3))
     r0123 = np.empty((3, 3))
-    for i0 in first:
+    for i0 in range(start, a0.shape[0], stride):
         for i1 in range(a1.shape[0]):
             for r in range(3):
                 for c in range(3):
@@ -145,10 +153,10 @@ def _rasterise_part(grid, origin, h, lengths, first, a0, a1, a2, a3, a4):
             ez -= l0 * r01[2, 2]
             _mark_segment(grid, origin, h, 0.0, 0.0, 0.0, ex, ey, ez)
             for i2 in range(a2.shape[0]):
-                r012[:, :] = r01
+                _copy3(r01, r012)
                 _turn(r012, 2, c2[i2], s2[i2])
                 for i3 in range(a3.shape[0]):
-                    r0123[:, :] = r012
+                    _copy3(r012, r0123)
                     _turn(r0123, 1, c3[i3], s3[i3])
                     wx, wy, wz = ex, ey, ez
                     wx -= l1 * r0123[0, 2]
@@ -176,10 +184,10 @@ def _rasterise(grid, origin, h, lengths, a0, a1, a2, a3, a4):
     n = grid.shape[0]
     parts = np.zeros((_RASTER_PARTS, n, n, n), dtype=np.bool_)
     for p in prange(_RASTER_PARTS):
-        first = np.arange(p, a0.shape[0], _RASTER_PARTS)
-        _rasterise_part(parts[p], origin, h, lengths, first, a0, a1, a2, a3, a4)
-    for x in prange(n):
-        for p in range(_RASTER_PARTS):
+        # np.int64: the parallel loop's index may be typed unsigned, which would compile the part twice
+        _rasterise_part(parts[p], origin, h, lengths, np.int64(p), _RASTER_PARTS, a0, a1, a2, a3, a4)
+    for p in range(_RASTER_PARTS):
+        for x in range(n):
             for y in range(n):
                 for z in range(n):
                     if parts[p, x, y, z]:
