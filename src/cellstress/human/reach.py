@@ -125,12 +125,13 @@ def _copy3(src, dst):
 @njit(cache=True)
 def _rasterise_part(grid, origin, h, lengths, start, stride, a0, a1, a2, a3, a4):
     """Mark every voxel the arm's three segments cross, for every combination of the five joints' samples,
-    the first joint's every ``stride``-th from ``start``. The arm's own forward kinematics
-    (arm_points_into) computed joint by joint with the same operations in the same order, so every point is
-    bit for bit the same: the elbow does not depend on the last three joints (rotation about the upper arm's
-    axis leaves it in place) and the wrist not on the last, so the upper arm is marked once per pair of the
-    first two joints' samples and the forearm once per four, not once per configuration of all five (the
-    same voxels for about a quarter of the work)."""
+    taking the first joint's every ``stride``-th sample from ``start``.
+
+    The points are arm_points_into's, computed joint by joint with the same operations in the same order, so
+    they are the same bit for bit. The elbow does not depend on the last three joints (rotation about the
+    upper arm's axis leaves it in place) nor the wrist on the last, so the upper arm is marked once per pair
+    of the first two joints' samples and the forearm once per four, not once per configuration of all five:
+    the same voxels for about a quarter of the work (tests/human/test_reach_build.py keeps the plain loop)."""
     c0, s0 = _cos_sin(a0, -1.0)
     c1, s1 = _cos_sin(a1, -1.0)
     c2, s2 = _cos_sin(a2, 1.0)
