@@ -148,7 +148,7 @@ def _rasterise_part(grid, origin, h, lengths, start, stride, a0, a1, a2, a3, a4)
                     r01[r, c] = 1.0 if r == c else 0.0
             _turn(r01, 0, c1[i1], s1[i1])
             _turn(r01, 1, c0[i0], s0[i0])
-            ex = ey = ez = 0.0
+            ex = ey = ez = 0.0  # accumulated as arm_points_into does, so the rounding is the same
             ex -= l0 * r01[0, 2]
             ey -= l0 * r01[1, 2]
             ez -= l0 * r01[2, 2]
