@@ -1,15 +1,18 @@
 """The first search on a fresh installation, phase by phase: what a new user waits for.
 
-    python benchmarks/cold_start.py [--cell s3-fence-gap] [--searcher plan] [--budget 200] [--warm]
+    python benchmarks/cold_start.py [--cell s3-fence-gap] [--searcher plan] [--budget 200] [--warm] [--warm-numba]
 
 Runs a fresh interpreter with empty caches (numba's cache in an empty NUMBA_CACHE_DIR, the reach field's in an
 empty CELLSTRESS_CACHE) and times, one after the other: the imports of the command line and the simulator, the
 worker's reach field (built on the first run, then read from its cache), the simulator's set-up for the cell,
 the search, and the report. For each phase it prints the wall time and the part of it numba spent compiling
 (from numba's ``numba:compile`` events). ``--warm`` runs the same again with the caches the first run left,
-as every later run sees them. The kernels compiled ahead and shipped with the package (cellstress.core.jit)
-are used as on a user's machine; ``--no-shipped`` switches them off to time numba compiling everything (what
-a user of another numba or Python waits). Run it on an idle machine; the first line says how many cores it had.
+as every later run sees them. ``--warm-numba`` runs it again with numba's cache of the first run but an empty
+reach-field cache: a new body size's first run, or, on a branch whose compiled code differs from the shipped
+archive (the first run then compiles it), what a user will wait once the archive is rebuilt. The kernels
+compiled ahead and shipped with the package (cellstress.core.jit) are used as on a user's machine;
+``--no-shipped`` switches them off to time numba compiling everything (what a user of another numba or Python
+waits). Run it on an idle machine; the first line says how many cores it had.
 """
 
 from __future__ import annotations
@@ -80,6 +83,8 @@ def main() -> None:
     ap.add_argument("--searcher", default="plan")
     ap.add_argument("--budget", type=int, default=200)
     ap.add_argument("--warm", action="store_true", help="run again with the caches of the first run")
+    ap.add_argument("--warm-numba", action="store_true",
+                    help="run again with numba's cache of the first run and an empty reach-field cache")
     ap.add_argument("--no-shipped", action="store_true", help="switch off the kernels shipped compiled")
     args = ap.parse_args()
     print(f"{os.cpu_count()} cores; cell {args.cell}, searcher {args.searcher}, budget {args.budget}; "
@@ -91,6 +96,10 @@ def main() -> None:
         if args.warm:
             show("warm (the caches of the cold run)", run(args.cell, args.searcher, args.budget, numba_dir,
                                                            cache_dir, shipped))
+        if args.warm_numba:
+            with tempfile.TemporaryDirectory() as fresh_cache_dir:
+                show("numba's cache of the cold run, empty reach-field cache",
+                     run(args.cell, args.searcher, args.budget, numba_dir, fresh_cache_dir, shipped))
 
 
 if __name__ == "__main__":

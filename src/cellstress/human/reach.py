@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from cellstress.core.io import atomic_write
-from cellstress.core.jit import njit
+from cellstress.core.jit import njit, prange
 
 # Ranges of motion [deg] (AAOS normal values): flexion 180 / extension 60, abduction 180 / adduction 30,
 # internal rotation 70 / external rotation 90, elbow flexion 0..150, wrist flexion 80 / extension 70.
@@ -40,14 +40,19 @@ _CACHE_VERSION = 3  # 2: upper-arm rotation sampled every 10 deg (was 20: gaps o
 
 
 @njit(cache=True)
-def _rotate(m, axis, angle):
-    """m @ R_axis(angle) in place, for 3x3 m and axis 0 (x), 1 (y) or 2 (z)."""
-    c, s = np.cos(angle), np.sin(angle)
+def _turn(m, axis, c, s):
+    """m @ R_axis(angle) in place, for 3x3 m, axis 0 (x), 1 (y) or 2 (z) and c, s = cos, sin of the angle."""
     i, j = (1, 2) if axis == 0 else ((2, 0) if axis == 1 else (0, 1))
     for r in range(3):
         a, b = m[r, i], m[r, j]
         m[r, i] = c * a + s * b
         m[r, j] = -s * a + c * b
+
+
+@njit(cache=True)
+def _rotate(m, axis, angle):
+    """m @ R_axis(angle) in place, for 3x3 m and axis 0 (x), 1 (y) or 2 (z)."""
+    _turn(m, axis, np.cos(angle), np.sin(angle))
 
 
 @njit(cache=True)
@@ -99,28 +104,95 @@ def _mark_segment(grid, origin, h, ax, ay, az, bx, by, bz):
 
 
 @njit(cache=True)
+def _cos_sin(angles, sign):
+    """cos and sin of sign * angles, exactly as _rotate computes them."""
+    c = np.empty(angles.shape[0])
+    s = np.empty(angles.shape[0])
+    for i in range(angles.shape[0]):
+        c[i] = np.cos(sign * angles[i])
+        s[i] = np.sin(sign * angles[i])
+    return c, s
+
+
+@njit(cache=True)
+def _copy3(src, dst):
+    """dst[:, :] = src for 3x3 arrays (a slice assignment would compile numba's shape checks: seconds)."""
+    for r in range(3):
+        for c in range(3):
+            dst[r, c] = src[r, c]
+
+
+@njit(cache=True)
+def _rasterise_part(grid, origin, h, lengths, start, stride, a0, a1, a2, a3, a4):
+    """Mark every voxel the arm's three segments cross, for every combination of the five joints' samples,
+    taking the first joint's every ``stride``-th sample from ``start``.
+
+    The points are arm_points_into's, computed joint by joint with the same operations in the same order, so
+    they are the same bit for bit. The elbow does not depend on the last three joints (rotation about the
+    upper arm's axis leaves it in place) nor the wrist on the last, so the upper arm is marked once per pair
+    of the first two joints' samples and the forearm once per four, not once per configuration of all five:
+    the same voxels for about a quarter of the work (tests/human/test_reach_build.py keeps the plain loop)."""
+    c0, s0 = _cos_sin(a0, -1.0)
+    c1, s1 = _cos_sin(a1, -1.0)
+    c2, s2 = _cos_sin(a2, 1.0)
+    c3, s3 = _cos_sin(a3, -1.0)
+    c4, s4 = _cos_sin(a4, -1.0)
+    l0, l1, l2 = lengths[0], lengths[1], lengths[2]
+    r01 = np.empty((3, 3))
+    r012 = np.empty((3, 3))
+    r0123 = np.empty((3, 3))
+    for i0 in range(start, a0.shape[0], stride):
+        for i1 in range(a1.shape[0]):
+            for r in range(3):
+                for c in range(3):
+                    r01[r, c] = 1.0 if r == c else 0.0
+            _turn(r01, 0, c1[i1], s1[i1])
+            _turn(r01, 1, c0[i0], s0[i0])
+            ex = ey = ez = 0.0  # accumulated as arm_points_into does, so the rounding is the same
+            ex -= l0 * r01[0, 2]
+            ey -= l0 * r01[1, 2]
+            ez -= l0 * r01[2, 2]
+            _mark_segment(grid, origin, h, 0.0, 0.0, 0.0, ex, ey, ez)
+            for i2 in range(a2.shape[0]):
+                _copy3(r01, r012)
+                _turn(r012, 2, c2[i2], s2[i2])
+                for i3 in range(a3.shape[0]):
+                    _copy3(r012, r0123)
+                    _turn(r0123, 1, c3[i3], s3[i3])
+                    wx, wy, wz = ex, ey, ez
+                    wx -= l1 * r0123[0, 2]
+                    wy -= l1 * r0123[1, 2]
+                    wz -= l1 * r0123[2, 2]
+                    _mark_segment(grid, origin, h, ex, ey, ez, wx, wy, wz)
+                    for i4 in range(a4.shape[0]):
+                        # the hand's direction: column 2 of r0123 turned by the wrist, as _turn does it
+                        c, s = c4[i4], s4[i4]
+                        tx, ty, tz = wx, wy, wz
+                        tx -= l2 * (c * r0123[0, 2] + s * r0123[0, 0])
+                        ty -= l2 * (c * r0123[1, 2] + s * r0123[1, 0])
+                        tz -= l2 * (c * r0123[2, 2] + s * r0123[2, 0])
+                        _mark_segment(grid, origin, h, wx, wy, wz, tx, ty, tz)
+
+
+_RASTER_PARTS = 8  # grids marked in parallel, then united: a union does not depend on the order of marking
+
+
+@njit(cache=True, parallel=True)
 def _rasterise(grid, origin, h, lengths, a0, a1, a2, a3, a4):
     """Mark every voxel the arm's three segments cross, for every combination of the five joints' samples (a
-    grid of joint space walked in place: as an array it would take ~250 MB at the coarse step)."""
-    pts = np.empty((3, 3))
-    rot = np.empty((3, 3))
-    q = np.empty(5)
-    for i0 in range(a0.shape[0]):
-        q[0] = a0[i0]
-        for i1 in range(a1.shape[0]):
-            q[1] = a1[i1]
-            for i2 in range(a2.shape[0]):
-                q[2] = a2[i2]
-                for i3 in range(a3.shape[0]):
-                    q[3] = a3[i3]
-                    for i4 in range(a4.shape[0]):
-                        q[4] = a4[i4]
-                        arm_points_into(q, lengths, rot, pts)
-                        _mark_segment(grid, origin, h, 0.0, 0.0, 0.0, pts[0, 0], pts[0, 1], pts[0, 2])
-                        _mark_segment(grid, origin, h, pts[0, 0], pts[0, 1], pts[0, 2],
-                                      pts[1, 0], pts[1, 1], pts[1, 2])
-                        _mark_segment(grid, origin, h, pts[1, 0], pts[1, 1], pts[1, 2],
-                                      pts[2, 0], pts[2, 1], pts[2, 2])
+    grid of joint space walked in place: as an array it would take ~250 MB at the coarse step). The first
+    joint's samples are dealt out in turn to _RASTER_PARTS grids marked in parallel, then OR'ed into grid."""
+    n = grid.shape[0]
+    parts = np.zeros((_RASTER_PARTS, n, n, n), dtype=np.bool_)
+    for p in prange(_RASTER_PARTS):
+        # np.int64: the parallel loop's index may be typed unsigned, which would compile the part twice
+        _rasterise_part(parts[p], origin, h, lengths, np.int64(p), _RASTER_PARTS, a0, a1, a2, a3, a4)
+    for p in range(_RASTER_PARTS):
+        for x in range(n):
+            for y in range(n):
+                for z in range(n):
+                    if parts[p, x, y, z]:
+                        grid[x, y, z] = True
 
 
 def _joint_axes(step_deg: tuple[float, float, float, float, float]) -> list[np.ndarray]:
@@ -186,8 +258,12 @@ class ReachField:
 
 
 def _build(lengths: tuple[float, float, float], spacing: float) -> ReachField:
-    from scipy import ndimage
+    origin = _grid(lengths, spacing)[1]
+    return ReachField(_signed_distance(_occupied(lengths, spacing), spacing), origin, spacing, float(sum(lengths)))
 
+
+def _occupied(lengths: tuple[float, float, float], spacing: float) -> np.ndarray:
+    """The voxels (of the field's grid) the arm's segments cross at the joint samples, bool (n, n, n)."""
     reach = float(sum(lengths))
     n, origin = _grid(lengths, spacing)
     occupied = np.zeros((n, n, n), dtype=np.bool_)
@@ -199,13 +275,19 @@ def _build(lengths: tuple[float, float, float], spacing: float) -> ReachField:
     _rasterise(occupied, origin, spacing, lengths_arr, *_joint_axes((6.0, 6.0, 10.0, 10.0, 10.0)))
     fine = np.rad2deg(spacing / reach) * 0.9
     _rasterise(occupied, origin, spacing, lengths_arr, *_joint_axes((fine, fine, 200.0, 200.0, 200.0)))
+    return occupied
+
+
+def _signed_distance(occupied: np.ndarray, spacing: float) -> np.ndarray:
+    """The rasterised arm closed (pinholes between samples), filled, and its signed distance, float32."""
+    from scipy import ndimage
+
     occupied = ndimage.binary_closing(occupied, structure=np.ones((3, 3, 3)), iterations=1)
     occupied = ndimage.binary_fill_holes(occupied)
     outside = ndimage.distance_transform_edt(~occupied, sampling=spacing)
     inside = ndimage.distance_transform_edt(occupied, sampling=spacing)
     # Voxel centres are samples of a surface that lies half a voxel beyond the outermost occupied centre.
-    sdf = np.where(occupied, -(inside - 0.5 * spacing), outside - 0.5 * spacing).astype(np.float32)
-    return ReachField(sdf, origin, spacing, reach)
+    return np.where(occupied, -(inside - 0.5 * spacing), outside - 0.5 * spacing).astype(np.float32)
 
 
 def _grid(lengths: tuple[float, float, float], spacing: float) -> tuple[int, float]:
