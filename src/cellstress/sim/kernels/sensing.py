@@ -120,12 +120,34 @@ def body_blocked(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr):
         for c in range(2, nh):
             if blocked >> c & 1:
                 continue
+            # (a capsule whose box misses the panel's by more than its radius cannot touch it: the articulated
+            # worker's eight capsules are tested against every panel within an arm's length, so most are skipped)
+            r = hr[c]
+            if nh != 6 and one_side(x0, y0, x1, y1, r, ha[c, 0], ha[c, 1], hb[c, 0], hb[c, 1], ha[c, 0], ha[c, 1],
+                                    hb[c, 0], hb[c, 1]):
+                continue
             if segment_rectangle_xyz(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2],
-                                     x0, y0, x1, y1, zlo, zhi)[0] < hr[c]:
+                                     x0, y0, x1, y1, zlo, zhi)[0] < r:
                 blocked |= 1 << c
                 if nh == 6:
                     return blocked
     return blocked
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def one_side(x0, y0, x1, y1, r, ax, ay, bx, by, cx, cy, dx, dy):
+    """Points a, b, c, d (plan view) all further than r from the vertical plane through the panel (x0, y0)-(x1,
+    y1), on the same side: nothing between them can touch the panel."""
+    nx, ny = y0 - y1, x1 - x0
+    n = np.sqrt(nx * nx + ny * ny)
+    if n == 0.0:
+        return False
+    nx, ny = nx / n, ny / n
+    da = (ax - x0) * nx + (ay - y0) * ny
+    db = (bx - x0) * nx + (by - y0) * ny
+    dc = (cx - x0) * nx + (cy - y0) * ny
+    dd = (dx - x0) * nx + (dy - y0) * ny
+    return min(da, db, dc, dd) > r or max(da, db, dc, dd) < -r
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -134,26 +156,26 @@ def trunk_clear(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr):
     return body_blocked(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr) == 0
 
 
-SWEEP_ANGLE = 0.2  # rad: the largest change of any angle (heading, trunk, arm joint) between checked poses
-SWEEP_SHIFT = 0.05  # m: the largest move of the feet or the hip between checked poses
+SWEEP_ANGLE = 0.3  # rad: the largest change of any angle (heading, trunk, arm joint) between checked poses
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def path_blocked(body, fences, obs_verts, obs_poly, obs_box, state, x1, y1, h1, f1, l1, ext1, W):
     """body_blocked along the articulated worker's way from the state's pose to (x1, y1, h1, f1, l1, ext1), not
-    only where it ends: at in-between poses (linear in every coordinate, no angle more than SWEEP_ANGLE and no
-    point of the feet or hip more than SWEEP_SHIFT apart), and along the paths of the capsules' ends (and the
-    arms' middles) from one in-between pose to the next, which must not cross a fence panel. Otherwise an arm
-    could pass through a panel between two time steps: it moves up to 45 degrees in one. The chords stand for
-    the arcs to within 5 mm at 0.2 rad, less than the thinnest capsule's radius. Returns the blocked capsules'
-    bits at the first in-between pose that fails (0: the whole way is clear)."""
+    only where it ends: at in-between poses (linear in every coordinate, no angle more than SWEEP_ANGLE apart),
+    and along the paths of the capsules' ends (and the arms' middles) from one in-between pose to the next,
+    which must not cross a fence panel. Otherwise an arm could pass through a panel between two time steps: it
+    moves up to 45 degrees in one. The chords stand for the arcs to within 12 mm at 0.3 rad (a point 1.1 m from
+    the axis it turns about), less than the thinnest capsule's radius. Returns the blocked capsules' bits at
+    the first in-between pose that fails (0: the whole way is clear)."""
     ha, hb, hr, sh, tr, ext, pa, pb = W.ha, W.hb, W.hr, W.sh, W.tr, W.ext2, W.pa, W.pb
     x0, y0, h0, f0, l0 = state[S_X], state[S_Y], state[S_HEADING], state[S_FWD], state[S_LAT]
     big = max(abs(h1 - h0), abs(f1 - f0), abs(l1 - l0))
     for i in range(1, 11):
         big = max(big, abs(ext1[i] - state[S_DROP + i]))
-    shift = max(abs(ext1[0] - state[S_DROP]), np.sqrt((x1 - x0) ** 2 + (y1 - y0) ** 2))
-    n = max(1, int(np.ceil(big / SWEEP_ANGLE)), int(np.ceil(shift / SWEEP_SHIFT)))
+    # (moving the feet or the hip alone moves every point on a straight line, which the paths below follow
+    # exactly: only turning needs poses in between)
+    n = max(1, int(np.ceil(big / SWEEP_ANGLE)))
     n_caps = int(body[B_N_CAPS])
     for s in range(n + 1):
         u = s / n
@@ -177,15 +199,20 @@ def path_blocked(body, fences, obs_verts, obs_poly, obs_box, state, x1, y1, h1, 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def swept_blocked(body, fences, pa, pb, ha, hb, hr, n_caps):
     """Bit c set: a path from capsule c's ends (pa, pb) to its ends now (ha, hb), or of an arm capsule's middle,
-    comes within the capsule's radius of a fence panel (trunk, head and arms: 2 .. n_caps - 1)."""
+    comes within the capsule's radius of a fence panel (trunk, head and arms: 2 .. n_caps - 1). A capsule whose
+    four ends are all on one side of the panel's plane, further than its radius, is skipped: most are."""
     blocked = 0
-    extent = body[B_HEAD_RISE] + body[B_R_HEAD] + body[B_SHOULDER_HALF] + body[B_ARM_LEN]
     for f in range(fences.shape[0]):
         x0, y0, x1, y1, zlo, zhi = fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3], fences[f, 4], fences[f, 5]
-        if point_segment_2d(ha[2, 0], ha[2, 1], x0, y0, x1, y1) > extent + 0.5:
-            continue
         for c in range(2, n_caps):
+            if blocked >> c & 1:
+                continue
             r = hr[c]
+            if min(pa[c, 2], pb[c, 2], ha[c, 2], hb[c, 2]) - r > zhi or \
+                    max(pa[c, 2], pb[c, 2], ha[c, 2], hb[c, 2]) + r < zlo or \
+                    one_side(x0, y0, x1, y1, r, pa[c, 0], pa[c, 1], pb[c, 0], pb[c, 1], ha[c, 0], ha[c, 1],
+                             hb[c, 0], hb[c, 1]):
+                continue
             for w in range(3 if c >= 4 else 2):
                 if w == 0:
                     sx, sy, sz, ex, ey, ez = pa[c, 0], pa[c, 1], pa[c, 2], ha[c, 0], ha[c, 1], ha[c, 2]

@@ -344,6 +344,8 @@ def move_worker(P, state, action, h0, f0, l0, frac, W):
     # articulated worker's motion is checked along the way, not only where it ends (path_blocked).
     final = False
     for attempt in range(3):
+        if articulated and final and nx == x and ny == y:
+            break  # the pose the worker is in: nothing to check
         if articulated:
             blocked = path_blocked(body, fences, obs_verts, obs_poly, obs_box, state, nx, ny, h, f, lt, ext, W)
         else:
