@@ -29,13 +29,14 @@ def main() -> None:
     ap.add_argument("--cells", default=",".join(f for f, _ in PAIRS), help="the flawed cells of the pairs to run")
     ap.add_argument("--searchers", default=",".join(SEARCHERS), help="registered searchers, e.g. plan,evolve,mcts")
     ap.add_argument("--no-twin", action="store_true", help="search the flawed cells only")
+    ap.add_argument("--twin-only", action="store_true", help="search the twins only")
     args = ap.parse_args()
     chosen, searchers = args.cells.split(","), args.searchers.split(",")
     print("| cell | searcher | runs | found | mean episodes | max episodes | hazardous episodes |")
     print("|---|---|---|---|---|---|---|")
     for flawed, twin in (p for p in PAIRS if p[0] in chosen):
         sim = Simulator(flawed)
-        for s in searchers:
+        for s in () if args.twin_only else searchers:
             eps = []
             for seed in range(args.seeds):
                 r = search(sim, s, budget=args.budget, seed=seed)
