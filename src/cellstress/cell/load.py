@@ -31,7 +31,8 @@ BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intr
                                   "s2-deceptive", "restart-auto", "restart-manual", "warning-field-short",
                                   "warning-field-ok", "mat-short", "mat-ok", "palletizing", "palletizing-fixed",
                                   "door-unlocked", "door-locked", "muting-long", "muting-ok",
-                                  "two-robots", "two-robots-fixed", "ssm-latency", "ssm-ok")
+                                  "two-robots", "two-robots-fixed", "ssm-latency", "ssm-ok", "reach-over",
+                                  "reach-over-ok")
 
 
 @dataclass(frozen=True)

@@ -120,6 +120,9 @@ class PhaseProblem(ArrivalProblem):
     def worker_distances(self, poses, points):
         return self.sim.worker_distances(poses, points)
 
+    def worker_capsules(self, poses):
+        return self.sim.worker_capsules(poses)
+
     def phase_step(self, choice: int) -> int:
         """The robot's phase of a first decision, in time steps."""
         return int(round(self.arrival(choice)[1] / self.dt))

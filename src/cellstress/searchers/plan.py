@@ -7,7 +7,11 @@ simulator as a black box; ``plan`` separates what the searcher controls from wha
 * **The worker is the searcher's own agent.** Where an action sequence takes the worker, and how far the
   worker's body and reach volumes are from a given point, depend on the actions and the fixed layout (walls,
   table, floor) only, so they are computed without playing anything (``Simulator.worker_paths``,
-  ``Simulator.worker_distances``).
+  ``Simulator.worker_distances``). For the articulated worker (issue 20), whose d_HR is measured to the body
+  capsules and whose arms are posed by its actions, the distance is to those capsules at the pose
+  (``Simulator.worker_capsules``), not to the reach volumes: the volumes are the same whatever the arms do, so
+  with them every arm action of a candidate predicted alike and the search could not tell a reach over a panel
+  from hanging arms.
 * **The robot system under test is learned** from the metric rows of the episodes played, and from nothing
   else:
 
@@ -67,6 +71,7 @@ from cellstress.sim import layout as L
 PLAN_KEY = 9
 POINT_GRID = 0.02  # robot points closer than this (per coordinate, rounded) are kept as one, with the least offset
 POSE_WEIGHTS = (1.0, 1.0, 0.3, 0.4)  # nearest-pose metric: x, y [m]; heading as 0.3 (cos, sin); flexions 0.4/rad
+CHUNK = 1_000_000  # capsule-point pairs measured at once (memory of the articulated worker's distances)
 
 
 @dataclass(frozen=True)
@@ -200,6 +205,18 @@ class _Model:
         self.seen: list[np.ndarray] = []
         self._tree = self._by_step = None
 
+    def distances(self, poses: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """The worker's side of d_HR from each of ``poses`` (n, N_POSE) to its ``points`` (n, m, 3; NaN: inf): the
+        paper worker's reach volumes and body (``worker_distances``); the articulated worker's body capsules."""
+        if not self.limb_features:
+            return self.sim.worker_distances(poses, points)
+        a, b, r = self.sim.worker_capsules(poses)
+        out = np.empty(points.shape[:2])
+        rows = max(1, CHUNK // max(1, a.shape[1] * points.shape[1]))
+        for i in range(0, len(poses), rows):
+            out[i:i + rows] = capsule_distances(a[i:i + rows], b[i:i + rows], r[i:i + rows], points[i:i + rows])
+        return out
+
     def _features(self, poses: np.ndarray) -> np.ndarray:
         wx, wy, wh, wf = POSE_WEIGHTS
         cols = [wx * poses[:, 0], wy * poses[:, 1], wh * np.cos(poses[:, 2]), wh * np.sin(poses[:, 2]),
@@ -246,7 +263,7 @@ class _Model:
             on_path = rows[:upto][keep]
             if len(on_path):
                 pts = on_path[:, [L.M_RX, L.M_RY, L.M_RZ]]
-                reach = self.sim.worker_distances(on_path[:, self.pose_cols], pts[:, None, :])[:, 0]
+                reach = self.distances(on_path[:, self.pose_cols], pts[:, None, :])[:, 0]
                 for row, point, dist in zip(on_path, pts, reach, strict=True):
                     k = base + int(row[L.M_STEP])
                     self.speed[r][k] = row[L.M_V]
@@ -326,6 +343,18 @@ class _Model:
             which = np.flatnonzero(use.ravel())
             if len(which):
                 rs = robot_step.ravel()[which]
-                d = self.sim.worker_distances(poses[which], pts[rs]) - off[rs]
+                d = self.distances(poses[which], pts[rs]) - off[rs]
                 dist[which] = np.minimum(dist[which], d.min(axis=1))
         return dist.reshape(n, steps).min(axis=1)
+
+
+def capsule_distances(a: np.ndarray, b: np.ndarray, r: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Distance from the surface of the nearest of the capsules (axis ``a``-``b``, (n, c, 3); radii (n, c)) to each
+    of ``points`` (n, m, 3), less than 0 inside one: (n, m); inf for a NaN point."""
+    ab = b - a
+    length2 = np.maximum(np.einsum("ncx,ncx->nc", ab, ab), 1e-18)
+    rel = points[:, None, :, :] - a[:, :, None, :]  # (n, c, m, 3)
+    t = np.clip(np.einsum("ncmx,ncx->ncm", rel, ab) / length2[:, :, None], 0.0, 1.0)
+    gap = rel - t[..., None] * ab[:, :, None, :]
+    d = (np.sqrt(np.einsum("ncmx,ncmx->ncm", gap, gap)) - r[:, :, None]).min(axis=1)
+    return np.where(np.isnan(d), np.inf, d)
