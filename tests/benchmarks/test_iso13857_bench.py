@@ -1,0 +1,74 @@
+"""The pure helpers of benchmarks/iso13857.py: the exact reach of a capsule at a height, and the agreement rule."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+_PATH = Path(__file__).resolve().parents[2] / "benchmarks" / "iso13857.py"
+_SPEC = importlib.util.spec_from_file_location("iso13857_bench", _PATH)
+bench = importlib.util.module_from_spec(_SPEC)
+_SPEC.loader.exec_module(bench)
+
+
+def brute_section(a, b, r, h, n=20001):
+    """max -y over the capsule's section at z = h, from a fine sampling of the axis (disc radius per point)."""
+    t = np.linspace(0.0, 1.0, n)
+    s = a + t[:, None] * (b - a)
+    u = s[:, 2] - h
+    ok = np.abs(u) <= r
+    if not ok.any():
+        return -np.inf
+    return float((-s[ok, 1] + np.sqrt(r * r - u[ok] ** 2)).max())
+
+
+def test_section_reach_matches_fine_sampling():
+    rng = np.random.default_rng(7)
+    a = rng.uniform(-1.0, 1.0, (300, 3))
+    b = rng.uniform(-1.0, 1.0, (300, 3))
+    r = rng.uniform(0.02, 0.2, 300)
+    heights = np.array([-0.5, 0.0, 0.3, 0.9])
+    got = bench.section_reach(a, b, r, heights)
+    assert got.shape == (300, 4)
+    for i in range(300):
+        for k, h in enumerate(heights):
+            want = brute_section(a[i], b[i], r[i], h)
+            spans = min(a[i, 2], b[i, 2]) - r[i] <= h <= max(a[i, 2], b[i, 2]) + r[i]
+            assert np.isfinite(got[i, k]) == spans
+            if np.isfinite(want):
+                assert got[i, k] == pytest.approx(want, abs=2e-4)
+                assert got[i, k] >= want - 1e-12  # exact: never below a sampled point
+
+
+def test_section_reach_special_cases():
+    # a level capsule at the height: its far end plus the radius
+    v = bench.section_reach(np.array([0.0, 0.0, 1.0]), np.array([0.0, -0.5, 1.0]), np.array(0.05), np.array([1.0]))
+    assert v[0] == pytest.approx(0.55)
+    # a vertical capsule: the radius beyond its axis wherever it spans the height, nothing above its end cap
+    v = bench.section_reach(np.array([0.0, -0.3, 0.0]), np.array([0.0, -0.3, 1.0]), np.array(0.1),
+                            np.array([0.5, 1.05, 1.2]))
+    assert v[0] == pytest.approx(0.4)
+    assert v[1] == pytest.approx(0.3 + np.sqrt(0.1 ** 2 - 0.05 ** 2))
+    assert v[2] == -np.inf
+
+
+def test_depth_reach_is_the_deepest_surface_point():
+    d = bench.depth_reach(np.array([[0.0, 0.2, 1.0]]), np.array([[0.0, -0.4, 1.5]]), np.array([0.03]))
+    assert d[0] == pytest.approx(0.43)
+
+
+def test_guide_equals_exact_for_a_level_capsule_at_the_height():
+    a, b, r = np.array([[0.0, 0.1, 1.2]]), np.array([[0.0, -0.6, 1.2]]), np.array([0.04])
+    g = bench.guide_reach(a, b, r, np.array([1.2, 1.5]))
+    assert g[0, 0] == pytest.approx(0.64)
+    assert g[0, 1] == pytest.approx(0.6 - (0.3 - 0.04))  # a height miss costs LAMBDA = 1 m per m
+
+
+@pytest.mark.parametrize(("c_iso", "c_sim", "verdict"), [
+    (0, 0, "agree"), (0, 100, "agree"), (0, 101, "beyond"), (800, 700, "agree"), (800, 699, "short"),
+    (800, 900, "agree"), (800, 901, "beyond"), (1500, 0, "short")])
+def test_agreement_is_within_one_step(c_iso, c_sim, verdict):
+    assert bench.agreement(c_iso, c_sim) == verdict
