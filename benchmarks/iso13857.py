@@ -168,31 +168,73 @@ def agreement(c_iso_mm: float, c_sim_mm: float) -> str:
 
 
 # ---- search -----------------------------------------------------------------------------------------------
+def crossings_free(y0, z0, x0, y1, z1, x1, r, free) -> np.ndarray:
+    """Between two consecutive poses, does every body point that crosses the fence's plane y = 0 cross it where
+    the plane is open (``free(x, z, r)``: above the top, or inside an opening, with the capsule's radius to
+    spare)? Points move in straight lines between the poses (fine for 50 ms steps). Arrays broadcast; True where
+    no point goes through a panel."""
+    crosses = np.asarray(y0 > 0.0) != np.asarray(y1 > 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f = np.where(crosses, y0 / (y0 - y1), 0.0)
+    xc, zc = x0 + f * (x1 - x0), z0 + f * (z1 - z0)
+    return np.logical_or(~crosses, free(xc, zc, r))
+
+
 class Objective:
     """What a search maximises: ``exact(a, b, r)`` (n, steps, caps, ...) -> (n, K) over the steps and capsules,
-    ``guide`` the same at one pose -> (n, K)."""
+    ``guide`` the same at one pose -> (n, K); ``free(x, z, r)``: where the fence's plane lets a capsule of
+    radius r through (above the top ``top``; inside the square hole or the slot of width ``e`` centred at
+    ``centre``)."""
 
     def __init__(self, heights_m: np.ndarray | None = None, centre: tuple[float, float] | None = None,
-                 slot: bool = False):
+                 slot: bool = False, top: float = OPENING_TOP, e: float = 0.0):
         self.heights = heights_m
-        self.centre, self.slot = centre, slot
+        self.centre, self.slot, self.top, self.e = centre, slot, top, e
+
+    def free(self, x, z, r) -> np.ndarray:
+        ok = np.asarray(z >= self.top + r)
+        if self.centre is not None:
+            inside = np.abs(z - self.centre[1]) <= self.e / 2 - r
+            if not self.slot:
+                inside &= np.abs(x - self.centre[0]) <= self.e / 2 - r
+            ok |= inside
+        return ok
+
+    def swept_ok(self, a, b, r) -> np.ndarray:
+        """(n,): no point of the trunk, head or arms (capsule ends and middles) passes through a panel between
+        consecutive poses of (n, steps + 1, caps, ...) (the kernel checks the poses only, every 50 ms)."""
+        pts = np.stack([a[:, :, 2:], (a[:, :, 2:] + b[:, :, 2:]) / 2, b[:, :, 2:]], axis=3)  # (n, s, c, 3, xyz)
+        p0, p1 = pts[:, :-1], pts[:, 1:]
+        rr = r[:, 1:, 2:, None]
+        ok = crossings_free(p0[..., 1], p0[..., 2], p0[..., 0], p1[..., 1], p1[..., 2], p1[..., 0], rr, self.free)
+        return ok.reshape(len(a), -1).all(axis=1)
 
     @property
     def k(self) -> int:
         return 1 if self.heights is None else len(self.heights)
 
     def exact(self, a, b, r) -> np.ndarray:
+        depth = depth_reach(a, b, r)
         if self.heights is None:
-            v = depth_reach(a, b, r)[..., None]
-        else:
-            v = section_reach(a, b, r, self.heights)
+            return depth.max(axis=(1, 2))[:, None]
+        # only capsules that get beyond the face at all can count (c_sim is clamped at 0): the rest skipped
+        v = np.full((*depth.shape, self.k), -np.inf)
+        hit = depth > 0.0
+        v[hit] = section_reach(a[hit], b[hit], r[hit], self.heights)
         return v.max(axis=(1, 2))
 
     def guide(self, a, b, r) -> np.ndarray:
+        """(n, K + extra): one column per objective, then a-agnostic set-ups the beam also keeps: the deepest
+        point of the body beyond the face, of the trunk and head, and the highest fingertip (a reach over a
+        low fence and down behind it, or up and over a high one, passes through poses that are poor for
+        the target height itself)."""
         if self.heights is not None:
             caps = slice(2, None)  # trunk, head, arms (the legs stay 0.2 m back)
-            return np.maximum(guide_reach(a[:, caps], b[:, caps], r[:, caps], self.heights).max(axis=1),
-                              section_reach(a, b, r, self.heights).max(axis=1))
+            per_height = np.maximum(guide_reach(a[:, caps], b[:, caps], r[:, caps], self.heights, 3).max(axis=1),
+                                    section_reach(a, b, r, self.heights).max(axis=1))
+            setups = np.stack([depth_reach(a, b, r).max(axis=1), depth_reach(a[:, 2:4], b[:, 2:4], r[:, 2:4]).max(1),
+                               b[:, 8:10, 2].max(axis=1)], axis=1)
+            return np.concatenate([per_height, setups], axis=1)
         # through an opening: depth, less the fingertip's miss of the opening in the fence's plane
         tip = b[:, 8:10]  # hands' capsule ends
         dz = tip[..., 2] - self.centre[1]
@@ -206,9 +248,11 @@ def floor_ok(a: np.ndarray, b: np.ndarray, r: np.ndarray) -> np.ndarray:
     return (low >= -FLOOR_TOL).all(axis=-1)
 
 
-def beam_search(sim: Simulator, obj: Objective, width: int, depth: int):
+def beam_search(sim: Simulator, obj: Objective, width: int, depth: int, swept: bool = True):
     """Best exact value per objective over every pose of every sequence the beam plays, and the sequence that
-    first reached it: (best (K,), sequences [tuple of action names or None], episodes played)."""
+    first reached it: (best (K,), sequences [tuple of action names or None], episodes played). A sequence that
+    puts a limb below the floor, or (``swept``) moves a body point through a panel between two poses, is
+    dropped with all that would follow it."""
     spa, n_act = sim.steps_per_action, sim.n_actions
     best = np.full(obj.k, -np.inf)
     best_seq: list[tuple[int, ...] | None] = [None] * obj.k
@@ -217,12 +261,15 @@ def beam_search(sim: Simulator, obj: Objective, width: int, depth: int):
     for _ in range(depth):
         kids = np.concatenate([np.repeat(beam, n_act, axis=0),
                                np.tile(np.arange(n_act), len(beam))[:, None]], axis=1)
-        poses = sim.worker_paths(kids)[:, -spa:, :]
+        # the action's poses and the one before it (none before the first: the worker starts 1.3 m away)
+        poses = sim.worker_paths(kids)[:, -spa - 1:, :]
         played += len(kids)
         a, b, r = sim.worker_capsules(poses.reshape(-1, poses.shape[-1]))
-        shape = (len(kids), spa, *a.shape[1:])
+        shape = (len(kids), poses.shape[1], *a.shape[1:])
         a, b, r = a.reshape(shape), b.reshape(shape), r.reshape(shape[:3])
-        ok = floor_ok(a, b, r).all(axis=1)
+        ok = obj.swept_ok(a, b, r) if swept else np.ones(len(kids), dtype=bool)
+        poses, a, b, r = poses[:, -spa:], a[:, -spa:], b[:, -spa:], r[:, -spa:]
+        ok &= floor_ok(a, b, r).all(axis=1)
         ex = np.where(ok[:, None], obj.exact(a, b, r), -np.inf)
         for k in range(obj.k):
             i = int(np.argmax(ex[:, k]))
@@ -230,10 +277,12 @@ def beam_search(sim: Simulator, obj: Objective, width: int, depth: int):
                 best[k], best_seq[k] = ex[i, k], tuple(int(v) for v in kids[i])
         g = obj.guide(a[:, -1], b[:, -1], r[:, -1])
         # one child per distinct last pose (the first), and only sequences that stayed off the floor
-        _, first = np.unique(np.round(poses[:, -1, :], 6), axis=0, return_index=True)
+        # (along a straight fence the worker's x does not matter: poses that differ only in x are one)
+        key = poses[:, -1, 1:] if obj.heights is not None else poses[:, -1, :]
+        _, first = np.unique(np.round(key, 6), axis=0, return_index=True)
         cand = np.sort(first[ok[first]])
         keep = set()
-        for k in range(obj.k):
+        for k in range(g.shape[1]):
             order = cand[np.argsort(-g[cand, k], kind="stable")]
             keep.update(int(i) for i in order[:width])
         beam = kids[sorted(keep)]
@@ -255,8 +304,8 @@ def run_reach_over(body: str, flexion: float, args, columns, rows) -> dict:
     out, t0, played = {}, time.perf_counter(), 0
     for b_mm in columns:
         sim = reach_over_sim(b_mm / 1000.0, body, flexion, args.spa)
-        obj = Objective(heights)
-        best, seqs, n = beam_search(sim, obj, args.width, args.depth)
+        obj = Objective(heights, top=b_mm / 1000.0)
+        best, seqs, n = beam_search(sim, obj, args.width, args.depth, not args.kernel_steps_only)
         played += n
         for k, a_mm in enumerate(rows):
             c = max(0.0, float(best[k])) * 1000.0 if np.isfinite(best[k]) else 0.0
@@ -308,8 +357,8 @@ def run_openings(body: str, flexion: float, args) -> None:
             best = -np.inf
             for x0 in starts:
                 sim = opening_sim(e_mm / 1000.0, shape, body, flexion, args.spa, x0)
-                obj = Objective(None, centre=(0.0, zc), slot=shape == "slot")
-                v, _, n = beam_search(sim, obj, args.width * 4, args.depth)
+                obj = Objective(None, centre=(0.0, zc), slot=shape == "slot", e=e_mm / 1000.0)
+                v, _, n = beam_search(sim, obj, args.width * 4, args.depth, not args.kernel_steps_only)
                 played += n
                 best = max(best, float(v[0]))
             c = max(0.0, best) * 1000.0
@@ -330,6 +379,8 @@ def main() -> None:
     ap.add_argument("--depth", type=int, default=8, help="actions per sequence")
     ap.add_argument("--spa", type=int, default=4, help="time steps per 0.2 s action")
     ap.add_argument("--columns", default="", help="b values [mm] to run (default: all of Table 2)")
+    ap.add_argument("--kernel-steps-only", action="store_true",
+                    help="accept what the kernel accepts (poses checked every time step, not the motion between)")
     ap.add_argument("--openings-only", action="store_true")
     ap.add_argument("--no-openings", action="store_true")
     ap.add_argument("--show", default="", help="A,B: print the witness action sequence of one cell")

@@ -72,3 +72,25 @@ def test_guide_equals_exact_for_a_level_capsule_at_the_height():
     (800, 900, "agree"), (800, 901, "beyond"), (1500, 0, "short")])
 def test_agreement_is_within_one_step(c_iso, c_sim, verdict):
     assert bench.agreement(c_iso, c_sim) == verdict
+
+
+def test_crossings_free_over_the_top_only():
+    free = bench.Objective(np.array([1.0]), top=1.4).free
+    # a point going from in front (y > 0) to behind at z 1.5 crosses above the top (1.4 + r)
+    assert bench.crossings_free(0.1, 1.5, 0.0, -0.1, 1.5, 0.0, 0.05, free)
+    # the same at z 1.2 goes through the panel; at 1.43 it grazes the edge within the radius
+    assert not bench.crossings_free(0.1, 1.2, 0.0, -0.1, 1.2, 0.0, 0.05, free)
+    assert not bench.crossings_free(0.1, 1.43, 0.0, -0.1, 1.43, 0.0, 0.05, free)
+    # the crossing height is interpolated: from (0.3, 1.0) to (-0.1, 1.8) it crosses at 1.6
+    assert bench.crossings_free(0.3, 1.0, 0.0, -0.1, 1.8, 0.0, 0.05, free)
+    # no crossing: always fine
+    assert bench.crossings_free(0.3, 0.2, 0.0, 0.1, 0.2, 0.0, 0.05, free)
+
+
+def test_crossings_free_through_an_opening():
+    square = bench.Objective(None, centre=(0.0, 1.5), e=0.12)
+    slot = bench.Objective(None, centre=(0.0, 1.5), slot=True, e=0.12)
+    assert square.free(np.array(0.0), np.array(1.5), 0.05)
+    assert not square.free(np.array(0.02), np.array(1.5), 0.05)  # 0.01 m to spare only
+    assert slot.free(np.array(2.0), np.array(1.5), 0.05)  # a slot runs the whole width
+    assert not slot.free(np.array(0.0), np.array(1.52), 0.05)
