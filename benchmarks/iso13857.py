@@ -200,6 +200,15 @@ class Objective:
             ok |= inside
         return ok
 
+    def niche(self, poses: np.ndarray) -> np.ndarray:
+        """A kind of pose the beam keeps a few of whatever their score: the heading in 45-degree steps; through an
+        opening also the right arm's flexion and abduction in 45-degree steps (which arm goes through matters)."""
+        key = np.round(poses[:, 2] / (np.pi / 4)).astype(np.int64) % 8
+        if self.heights is None:
+            q = np.round(poses[:, 11:13] / (np.pi / 4)).astype(np.int64)
+            key = key * 100 + q[:, 0] * 10 + q[:, 1]
+        return key
+
     def swept_ok(self, a, b, r) -> np.ndarray:
         """(n,): no point of the trunk, head or arms (capsule ends and middles) passes through a panel between
         consecutive poses of (n, steps + 1, caps, ...) (the kernel checks the poses only, every 50 ms)."""
@@ -235,11 +244,16 @@ class Objective:
             setups = np.stack([depth_reach(a, b, r).max(axis=1), depth_reach(a[:, 2:4], b[:, 2:4], r[:, 2:4]).max(1),
                                b[:, 8:10, 2].max(axis=1)], axis=1)
             return np.concatenate([per_height, setups], axis=1)
-        # through an opening: depth, less the fingertip's miss of the opening in the fence's plane
-        tip = b[:, 8:10]  # hands' capsule ends
-        dz = tip[..., 2] - self.centre[1]
-        miss = np.abs(dz) if self.slot else np.hypot(tip[..., 0] - self.centre[0], dz)
-        return np.maximum((-tip[..., 1] - 0.5 * miss).max(axis=1), depth_reach(a, b, r).max(axis=1))[:, None]
+        # through an opening: each hand's depth, less by how much the arm's line (shoulder to fingertip) misses
+        # the opening where it meets the fence's plane (the rest of the body coming close scores nothing)
+        sh, tip = a[:, 4:6], b[:, 8:10]  # shoulders (upper arms' starts), hands' capsule ends
+        d = tip - sh
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t0 = np.where(d[..., 1] < 0.0, sh[..., 1] / -d[..., 1], np.inf)
+            cx, cz = sh[..., 0] + t0 * d[..., 0], sh[..., 2] + t0 * d[..., 2]
+        miss = np.abs(cz - self.centre[1]) if self.slot else np.hypot(cx - self.centre[0], cz - self.centre[1])
+        miss = np.where(np.isfinite(miss), miss, 10.0)  # pointing away from the fence
+        return (-tip[..., 1] - miss).max(axis=1)[:, None]
 
 
 def floor_ok(a: np.ndarray, b: np.ndarray, r: np.ndarray) -> np.ndarray:
@@ -248,7 +262,8 @@ def floor_ok(a: np.ndarray, b: np.ndarray, r: np.ndarray) -> np.ndarray:
     return (low >= -FLOOR_TOL).all(axis=-1)
 
 
-def beam_search(sim: Simulator, obj: Objective, width: int, depth: int, swept: bool = True):
+def beam_search(sim: Simulator, obj: Objective, width: int, depth: int, swept: bool = True,
+                per_heading: int = 0):
     """Best exact value per objective over every pose of every sequence the beam plays, and the sequence that
     first reached it: (best (K,), sequences [tuple of action names or None], episodes played). A sequence that
     puts a limb below the floor, or (``swept``) moves a body point through a panel between two poses, is
@@ -281,10 +296,17 @@ def beam_search(sim: Simulator, obj: Objective, width: int, depth: int, swept: b
         key = poses[:, -1, 1:] if obj.heights is not None else poses[:, -1, :]
         _, first = np.unique(np.round(key, 6), axis=0, return_index=True)
         cand = np.sort(first[ok[first]])
+        # per objective, the best `width`, and the best `per_heading` of each niche (obj.niche): a reach turned
+        # sideways (the shoulder to the fence) starts by turning away from the best frontal poses
+        niche = obj.niche(poses[cand, -1])
+        niches = np.unique(niche)
         keep = set()
         for k in range(g.shape[1]):
-            order = cand[np.argsort(-g[cand, k], kind="stable")]
-            keep.update(int(i) for i in order[:width])
+            order = np.argsort(-g[cand, k], kind="stable")
+            keep.update(int(i) for i in cand[order[:width]])
+            if per_heading:
+                for h in niches:
+                    keep.update(int(i) for i in cand[order[niche[order] == h][:per_heading]])
         beam = kids[sorted(keep)]
     names = sim.action_names
     return best, [None if s is None else tuple(names[i] for i in s) for s in best_seq], played
@@ -305,7 +327,8 @@ def run_reach_over(body: str, flexion: float, args, columns, rows) -> dict:
     for b_mm in columns:
         sim = reach_over_sim(b_mm / 1000.0, body, flexion, args.spa)
         obj = Objective(heights, top=b_mm / 1000.0)
-        best, seqs, n = beam_search(sim, obj, args.width, args.depth, not args.kernel_steps_only)
+        best, seqs, n = beam_search(sim, obj, args.width, args.depth, not args.kernel_steps_only,
+                                       args.per_heading)
         played += n
         for k, a_mm in enumerate(rows):
             c = max(0.0, float(best[k])) * 1000.0 if np.isfinite(best[k]) else 0.0
@@ -340,42 +363,58 @@ def print_reach_over(out, body, flexion, columns, rows, secs, played, args) -> N
           f"{played} sequences played, {secs:.1f} s")
 
 
+FITS = ((0.025, "hand"), (0.04, "forearm"), (0.05, "upper arm"))  # capsule radii, human/body.py
+
+
+def fits(e_m: float) -> str:
+    """The largest limb capsule whose diameter an opening of width e lets through ("none": only a fingertip's
+    worth of the hand's rounded end pokes in, r - sqrt(r^2 - e^2/4))."""
+    names = [name for r, name in FITS if 2 * r < e_m]
+    return names[-1] if names else "none"
+
+
 def run_openings(body: str, flexion: float, args) -> None:
     t0, played = time.perf_counter(), 0
     zc = shoulder_height(body)
     print(f"\n### Table 4 (openings), {body}, trunk flexion up to {flexion:g} deg, opening centred at "
           f"{zc:.3f} m\n")
-    print("| e [mm] | body part (table) | slot s_r / c_sim | square s_r / c_sim |")
-    print("|---|---|---|---|")
-    # the worker's start across the opening: its right shoulder in front of it (facing it), or its body's axis
-    # (so that, turned sideways, the shoulder is): where a person stands is the standard's worst case
-    starts = (shoulder_half(body), 0.0)
-    for row in TABLE_4:
-        e_mm = row.e_max_mm
+    print("| e [mm] | row | body part (table) | limb that fits | slot s_r / c_sim | square s_r / c_sim |")
+    print("|---|---|---|---|---|---|")
+    # Each row at its upper bound, and two more openings of the last row (60 and 90 mm: the hand, the forearm
+    # through). The worker starts with its body's axis across the opening's centre: turned sideways, a shoulder
+    # is then in front of it (the deepest reach; facing it, the other arm stops at the panel).
+    rows = [(r.e_max_mm, r) for r in TABLE_4]
+    rows[-1:-1] = [(60.0, TABLE_4[-1]), (90.0, TABLE_4[-1])]
+    for e_mm, row in rows:
+        e = e_mm / 1000.0
         cells = []
         for shape in ("slot", "square"):
-            best = -np.inf
-            for x0 in starts:
-                sim = opening_sim(e_mm / 1000.0, shape, body, flexion, args.spa, x0)
-                obj = Objective(None, centre=(0.0, zc), slot=shape == "slot", e=e_mm / 1000.0)
-                v, _, n = beam_search(sim, obj, args.width * 4, args.depth, not args.kernel_steps_only)
-                played += n
-                best = max(best, float(v[0]))
-            c = max(0.0, best) * 1000.0
+            sim = opening_sim(e, shape, body, flexion, args.spa, 0.0)
+            obj = Objective(None, centre=(0.0, zc), slot=shape == "slot", e=e)
+            # nothing but a fingertip's worth fits below the hand's diameter: a small search suffices there
+            big = fits(e) != "none"
+            v, _, n = beam_search(sim, obj, args.width * (2 if big else 1), args.depth, not args.kernel_steps_only,
+                                  1 if big else 0)
+            played += n
+            c = max(0.0, float(v[0])) * 1000.0
             sr = opening_distance(e_mm, shape)
-            cells.append(f"{sr:g} / {c:.0f}{' -' if agreement(sr, c) == 'short' else ''}"
-                         f"{' **+**' if agreement(sr, c) == 'beyond' else ''}")
-        print(f"| {row.e_above_mm:g} < e <= {e_mm:g} | {row.body_part} | " + " | ".join(cells) + " |", flush=True)
-    print(f"\n(e at each row's upper bound; beam width {args.width * 4}, depth {args.depth}, {played} sequences "
-          f"played, {time.perf_counter() - t0:.1f} s)")
+            verdict = agreement(sr, c)
+            cells.append(f"{sr:g} / {c:.0f}{' -' if verdict == 'short' else ''}"
+                         f"{' **+**' if verdict == 'beyond' else ''}")
+        print(f"| {e_mm:g} | {row.e_above_mm:g} < e <= {row.e_max_mm:g} | {row.body_part} | {fits(e)} | "
+              + " | ".join(cells) + " |", flush=True)
+    print(f"\n(beam width {args.width * 2} and 1 per niche where a limb fits, {args.width} otherwise; depth "
+          f"{args.depth}; {played} sequences played, {time.perf_counter() - t0:.1f} s)")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="columns 1000, 1400, 2000, 2500, p95-male, 55 deg only")
-    ap.add_argument("--bodies", default="p95-male,p50-male")
+    ap.add_argument("--bodies", default="p95-male")
     ap.add_argument("--flexion", default="55", help="largest trunk flexion(s) [deg], comma-separated")
     ap.add_argument("--width", type=int, default=8, help="beam children kept per objective (hazard height)")
+    ap.add_argument("--per-heading", type=int, default=2,
+                    help="beam children kept per objective and 45-degree heading besides --width")
     ap.add_argument("--depth", type=int, default=8, help="actions per sequence")
     ap.add_argument("--spa", type=int, default=4, help="time steps per 0.2 s action")
     ap.add_argument("--columns", default="", help="b values [mm] to run (default: all of Table 2)")
