@@ -2,7 +2,8 @@
 worker gets, against the standard's safety distances.
 
     python benchmarks/iso13857.py [--quick] [--bodies p95-male,p50-male] [--flexion 55,90] [--width 8]
-                                  [--depth 8] [--spa 4] [--openings-only | --no-openings] [--show A,B]
+                                  [--per-heading 2] [--depth 8] [--spa 4] [--columns 1000,1400]
+                                  [--openings-only | --no-openings] [--kernel-steps-only] [--show A,B]
 
 Reach over (Table 2, high risk): for each structure height b of the table's columns, a cell with one straight
 fence panel (bottom 0, top b) across the floor and the worker (``human: {model: articulated, body: ...}``)
@@ -15,12 +16,14 @@ height; c_sim is the deepest point of the body beyond the face.
 The search is a deterministic beam search over the worker's 112 actions (no random numbers: stable sorts, ties
 to the lower index): every child of the beam is played from the start by ``Simulator.worker_paths`` (blocking
 by the fence included), its poses turned into capsules by ``Simulator.worker_capsules``; for each objective (a
-hazard height) the ``--width`` children with the best guide score at their last pose join the next beam
-(identical poses once). A sequence with a limb below the floor is dropped (the kernel does not stop arms at the
-floor). Agreement, per cell: |c_sim - c_iso| <= 100 mm (one step of the table's c grid), with c_sim = 0 where
-no part of the body gets beyond the face at that height; rows the standard calls out of reach (c = 0) thus
-agree when the worker gets at most 100 mm beyond the face. docs/results.md and docs/worker.md discuss the
-numbers.
+hazard height, and a-agnostic set-ups) the ``--width`` children with the best guide score at their last pose,
+and the best ``--per-heading`` of each niche (45-degree heading; through an opening also the arm's pose), join
+the next beam (identical poses once). A sequence is dropped when a limb goes below the floor or a body point
+crosses the fence's plane between two time steps where the plane is closed (the kernel checks the poses, not
+the motion between them: ``Objective.swept_ok``). Agreement, per cell: |c_sim - c_iso| <= 100 mm (one step of
+the table's c grid), with c_sim = 0 where no part of the body gets beyond the face at that height; rows the
+standard calls out of reach (c = 0) thus agree when the worker gets at most 100 mm beyond the face.
+docs/results.md and docs/worker.md discuss the numbers.
 """
 
 from __future__ import annotations
