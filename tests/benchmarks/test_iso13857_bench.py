@@ -94,3 +94,9 @@ def test_crossings_free_through_an_opening():
     assert not square.free(np.array(0.02), np.array(1.5), 0.05)  # 0.01 m to spare only
     assert slot.free(np.array(2.0), np.array(1.5), 0.05)  # a slot runs the whole width
     assert not slot.free(np.array(0.0), np.array(1.52), 0.05)
+
+
+@pytest.mark.parametrize(("e", "limb"), [(0.04, "none"), (0.05, "none"), (0.06, "hand"), (0.09, "forearm"),
+                                         (0.12, "upper arm")])
+def test_fits_names_the_thickest_limb_through(e, limb):
+    assert bench.fits(e) == limb
