@@ -100,3 +100,20 @@ def test_crossings_free_through_an_opening():
                                          (0.12, "upper arm")])
 def test_fits_names_the_thickest_limb_through(e, limb):
     assert bench.fits(e) == limb
+
+
+def test_reach_over_cell_walks_up_to_the_fence_and_a_witness_replays():
+    """The benchmark's cell: five walking actions end exactly at the closest the feet get (0.2 m); a reach over
+    the 1.4 m panel (arms up, bend over it) gets the hand beyond the face, and the search's exact value is the
+    one the witness gives again."""
+    sim = bench.reach_over_sim(1.4, "p95-male", 55.0, 4)
+    walk = np.array([[sim.action_index("walk+upright")] * 5])
+    assert sim.worker_paths(walk)[0, -1, 1] == pytest.approx(0.2, abs=1e-5)
+    obj = bench.Objective(np.array([1.4]), top=1.4)
+    seq = ("walk+reach-high", "walk+upright", "walk+tiptoe", "walk+bend-forward", "stand+reach-forward")
+    c = bench.replay_value(sim, obj, seq, 0)
+    assert 0.5 < c < 0.95  # 0.68 m when written: the panel stops the bend at about 14 degrees
+    acts = np.array([[sim.action_index(s) for s in seq]])
+    a, b, r = sim.worker_capsules(sim.worker_paths(acts)[0])
+    assert obj.exact(a[None], b[None], r[None])[0, 0] == c
+    assert obj.swept_ok(a[None], b[None], r[None])[0]  # a motion a body can make: nothing through the panel
