@@ -19,8 +19,9 @@ by the fence included), its poses turned into capsules by ``Simulator.worker_cap
 hazard height, and a-agnostic set-ups) the ``--width`` children with the best guide score at their last pose,
 and the best ``--per-heading`` of each niche (45-degree heading; through an opening also the arm's pose), join
 the next beam (identical poses once). A sequence is dropped when a limb goes below the floor or a body point
-crosses the fence's plane between two time steps where the plane is closed (the kernel checks the poses, not
-the motion between them: ``Objective.swept_ok``). Agreement, per cell: |c_sim - c_iso| <= 100 mm (one step of
+crosses the fence's plane between two time steps where the plane is closed (``Objective.swept_ok``: a check
+of its own, independent of the kernel's, which tests the motion between poses too: kernels.sensing.path_blocked).
+Agreement, per cell: |c_sim - c_iso| <= 100 mm (one step of
 the table's c grid), with c_sim = 0 where no part of the body gets beyond the face at that height; rows the
 standard calls out of reach (c = 0) thus agree when the worker gets at most 100 mm beyond the face.
 docs/results.md and docs/worker.md discuss the numbers.
