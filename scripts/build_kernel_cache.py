@@ -56,6 +56,9 @@ COMMANDS = [
     ["search", "two-robots", "--searcher", "plan", "--budget", "20", "--seed", "0", "--out", "{out}/two"],
     ["verify", "two-robots", "--horizon", "2", "--out", "{out}/v2"],
     ["search", "ssm-latency", "--searcher", "plan", "--budget", "20", "--seed", "0", "--out", "{out}/ssm"],
+    # the articulated worker: plan measures its capsules (kernels.pose_capsules), the report draws them
+    ["search", "reach-over", "--searcher", "plan", "--budget", "20", "--seed", "0", "--out", "{out}/arms"],
+    ["check", "reach-over"],
     ["simulate", "s3-fence-gap", "--actions", "walk+upright,walk+upright"],
     ["check", "s3-fence-gap"],
     ["show", "s3-fence-gap", "--out", "{out}/show.png"],
