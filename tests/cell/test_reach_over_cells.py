@@ -11,7 +11,8 @@ from cellstress.cell.load import builtin_text, load_cell
 from cellstress.core.iso13857 import reach_over_distance
 from cellstress.sim.simulator import Simulator
 
-WITNESS = "walk+upright,walk+upright,stand+bend-forward,stand+bend-forward,stand+bend-forward,stand+reach-over"
+WITNESS = ("walk+reach-side,walk+reach-side,turn-right-45+reach-over,side-right+bend-forward,"
+           "turn-right-45+stand-up")  # docs/cells.md: found by plan
 ZONE_FRONT = 1.111  # m: the swept zone's front edge, the baseline's (docs/cells.md, ISO 13855 arithmetic)
 
 
