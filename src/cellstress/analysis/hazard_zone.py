@@ -97,22 +97,22 @@ def closest_on_zone(zone: HazardZone, point, hazard_point, i: int) -> Closest:
                    zone.part_names[int(zone.part[i])], round(float(zone.t[i]), 3))
 
 
-def hazard_zone(layout, sample_dt: float = SAMPLE_DT, robot: int | None = None) -> HazardZone:
-    """Sample the robot capsules over one cycle (before any stop) into floor stadiums. In a cell of several
-    robots: every robot's, each over its own cycle (``cycle`` is robot 0's), or robot ``robot``'s only."""
-    P = layout.params
+def robot_poses(P, sample_dt: float, robot: int | None = None) -> list[tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                                             np.ndarray]]:
+    """Each robot's capsules (``robot``'s only, if given) every ``sample_dt`` over its own cycle, before any stop:
+    per robot (times, capsule indices, axis ends a, b: (times, capsules, 3)). Robot 0 is posed by
+    ``kernels.robot_live``; robots 1.. at t = k * sample_dt without the pre-stop table (``kernels.other_robots``)."""
     W = K.make_work(P)
     nx = P.x_scal.shape[0]
-    robots = range(nx + 1) if robot is None else (robot,)
     parts = []
-    for r in robots:
+    for r in range(nx + 1) if robot is None else (robot,):
         scal = P.scal if r == 0 else P.x_scal[r - 1]
         ts = np.arange(0.0, float(scal[L.C_CYCLE]), sample_dt)
         c0 = 0 if r == 0 else int(P.x_cap0[r - 1])
         caps = np.arange(c0, c0 + (P.cap_joint.shape[0] if r == 0 else int(P.x_ncap[r - 1])))
         ra = np.empty((len(ts), len(caps), 3))
         rb = np.empty((len(ts), len(caps), 3))
-        if r > 0:  # robots 1.. posed at t = k * sample_dt, without the pre-stop table (kernels.other_robots)
+        if r > 0:
             x_scal = P.x_scal.copy()
             x_scal[:, L.C_DT] = sample_dt
             Pr = P._replace(x_scal=x_scal, pre_xv=np.zeros((0, nx)))
@@ -125,6 +125,14 @@ def hazard_zone(layout, sample_dt: float = SAMPLE_DT, robot: int | None = None) 
             ra[k] = W.ra[caps]
             rb[k] = W.rb[caps]
         parts.append((ts, caps, ra, rb))
+    return parts
+
+
+def hazard_zone(layout, sample_dt: float = SAMPLE_DT, robot: int | None = None) -> HazardZone:
+    """Sample the robot capsules over one cycle (before any stop) into floor stadiums. In a cell of several
+    robots: every robot's, each over its own cycle (``cycle`` is robot 0's), or robot ``robot``'s only."""
+    P = layout.params
+    parts = robot_poses(P, sample_dt, robot)
     a = np.concatenate([ra[:, :, :2].reshape(-1, 2) for _, _, ra, _ in parts])
     b = np.concatenate([rb[:, :, :2].reshape(-1, 2) for _, _, _, rb in parts])
     r_ = np.concatenate([np.broadcast_to(P.cap_r[caps], (len(ts), len(caps))).reshape(-1)

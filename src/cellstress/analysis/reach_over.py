@@ -25,11 +25,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cellstress.analysis.hazard_zone import SAMPLE_DT
+from cellstress.analysis.hazard_zone import SAMPLE_DT, robot_poses
 from cellstress.analysis.plane import point_segment
 from cellstress.core import iso13857 as T
-from cellstress.sim import kernels as K
-from cellstress.sim import layout as L
 
 BALL_STEP = 0.02  # m, at most this far between the centres of the balls covering a capsule
 TABLE_2_COVERS_TABLE_1 = all(
@@ -71,28 +69,8 @@ def hazard_volume(layout, sample_dt: float = SAMPLE_DT, robot: int | None = None
     """Balls covering the robot capsules over one cycle (before any stop), posed as ``hazard_zone`` poses them;
     in a cell of several robots every robot's, each over its own cycle, or robot ``robot``'s only."""
     P = layout.params
-    W = K.make_work(P)
-    nx = P.x_scal.shape[0]
     cs, rs, ts, ps = [], [], [], []
-    for r in range(nx + 1) if robot is None else (robot,):
-        scal = P.scal if r == 0 else P.x_scal[r - 1]
-        times = np.arange(0.0, float(scal[L.C_CYCLE]), sample_dt)
-        c0 = 0 if r == 0 else int(P.x_cap0[r - 1])
-        caps = np.arange(c0, c0 + (P.cap_joint.shape[0] if r == 0 else int(P.x_ncap[r - 1])))
-        ra = np.empty((len(times), len(caps), 3))
-        rb = np.empty((len(times), len(caps), 3))
-        if r > 0:  # robots 1.. at t = k * sample_dt, without the pre-stop table, as in hazard_zone
-            x_scal = P.x_scal.copy()
-            x_scal[:, L.C_DT] = sample_dt
-            Pr = P._replace(x_scal=x_scal, pre_xv=np.zeros((0, nx)))
-            state = np.full(L.NS, np.inf)
-        for k, t in enumerate(times):
-            if r == 0:
-                K.robot_live(P, float(t), np.inf, W)
-            else:
-                K.other_robots(Pr, np.int64(k), state, W)
-            ra[k] = W.ra[caps]
-            rb[k] = W.rb[caps]
+    for times, caps, ra, rb in robot_poses(P, sample_dt, robot):
         for j, cap in enumerate(caps):
             rad = float(P.cap_r[cap])
             length = float(np.linalg.norm(rb[0, j] - ra[0, j]))  # rigid: the same at every pose
