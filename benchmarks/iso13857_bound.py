@@ -2,6 +2,7 @@
 (issue 20): which of the standard's distances any honest model of that body could agree with.
 
     python benchmarks/iso13857_bound.py [--body p95-male] [--low-risk] [--flexion 180] [--tiptoe 0.08]
+                                        [--extra-arm 0]
 
 The body is reduced to what limits a reach over an edge, and everything else is given away, so that the reach
 computed is more than the articulated worker (or a real person of that size, without climbing) can achieve:
@@ -65,11 +66,11 @@ class Body2D:
         return self.hip_high + self.trunk + self.arm
 
 
-def body_2d(name: str, flexion_deg: float, tiptoe: float) -> Body2D:
+def body_2d(name: str, flexion_deg: float, tiptoe: float, extra_arm: float = 0.0) -> Body2D:
     size = BODY_SIZES[name]
     h = size.stature
     return Body2D(hip_low=POSTURES["crouch"].hip_height(h), hip_high=POSTURES["stand"].hip_height(h) + tiptoe,
-                  trunk=SHOULDER_ABOVE_HIP * h, arm=size.arm_length + HAND_RADIUS,
+                  trunk=SHOULDER_ABOVE_HIP * h, arm=size.arm_length + HAND_RADIUS + extra_arm,
                   max_flexion=math.radians(flexion_deg))
 
 
@@ -140,9 +141,11 @@ def main() -> None:
     ap.add_argument("--low-risk", action="store_true", help="Table 1 instead of Table 2")
     ap.add_argument("--flexion", type=float, default=180.0, help="largest trunk flexion [deg]")
     ap.add_argument("--tiptoe", type=float, default=TIPTOE_RISE, help="heel lift on tiptoe [m]")
+    ap.add_argument("--extra-arm", type=float, default=0.0,
+                    help="length added to the arm [m], e.g. for the shoulder girdle, which neither model moves")
     args = ap.parse_args()
     table = TABLE_1 if args.low_risk else TABLE_2
-    body = body_2d(args.body, args.flexion, args.tiptoe)
+    body = body_2d(args.body, args.flexion, args.tiptoe, args.extra_arm)
     print(f"{table.table}, {args.body}: hip {body.hip_low:.3f}-{body.hip_high:.3f} m, trunk {body.trunk:.3f} m, "
           f"arm + hand radius {body.arm:.3f} m, flexion <= {args.flexion:g} deg, top {body.top:.3f} m")
     print("cells: c_iso / c_bound [mm]; '!' unattainable (c_iso > c_bound + 100), '=' exact (a above the top)")
