@@ -9,7 +9,7 @@ import pytest
 
 from cellstress.sim import layout as L
 from cellstress.sim.determinism import check_determinism
-from cellstress.sim.simulator import Simulator, _state_at
+from cellstress.sim.simulator import Simulator
 from cellstress.verifier.tree import merge_keys
 
 STRAIGHT = ["walk+upright"] * 16  # from the start, 0.9 m in front of the door, straight through it
@@ -109,20 +109,9 @@ def test_every_way_of_playing_agrees(cell):
 
 
 @pytest.mark.parametrize("cell", ["door-unlocked", "door-locked"])
-def test_replayed_latches_match_the_kernel(cell):
+def test_replayed_latches_match_the_kernel(cell, replay_latches):
     """``Simulator._state_at`` replays a cut action's rows: the door's push and opening included, bit for bit."""
-    sim = Simulator(cell)
-    state = sim.reset()
-    for a in STRAIGHT:
-        nxt, rows = sim.step(state, a)
-        again = nxt.copy()
-        again[L.S_TSTOP:L.S_UNSAFE] = 0.0
-        again[L.S_LIVE:] = 0.0
-        _state_at(again, state, rows, sim.params)
-        assert again.tobytes() == nxt.tobytes(), a
-        state = nxt
-        if sim.is_unsafe(state):
-            break
+    state = replay_latches(Simulator(cell), STRAIGHT)
     assert state[L.S_DOOR_REQ] < np.inf
 
 

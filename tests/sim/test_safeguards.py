@@ -130,22 +130,10 @@ def test_mat_sees_the_feet_only():
     ("restart-auto", INTO_BAY + ["walk+bend-forward"] * 4),
     ("warning-field-ok", ["walk+upright"] * 8),
 ])
-def test_replayed_latches_match_the_kernel(cell, acts):
+def test_replayed_latches_match_the_kernel(cell, acts, replay_latches):
     """A criterion that judges contacts may end an action early; the simulator then replays the latches from the
     rows (``_state_at``). Replayed over a whole action, they must give the kernel's own state, bit for bit: the
-    stop, the reduction, the release and its anchor."""
-    from cellstress.sim.simulator import _state_at
-
-    sim = Simulator(cell)
-    state = sim.reset()
-    for a in acts:
-        nxt, rows = sim.step(state, a)
-        again = nxt.copy()
-        again[L.S_TSTOP:L.S_UNSAFE] = 0.0
-        again[L.S_LIVE:] = 0.0
-        _state_at(again, state, rows, sim.params)
-        assert again.tobytes() == nxt.tobytes(), a
-        state = nxt
-        if sim.is_unsafe(state):  # (restart-auto: the action with the release ends at the contact)
-            break
+    stop, the reduction, the release and its anchor. (restart-auto: the action with the release ends at the
+    contact.)"""
+    state = replay_latches(Simulator(cell), acts)
     assert state[L.S_LIVE] == 1.0
