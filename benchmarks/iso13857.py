@@ -4,6 +4,7 @@ worker gets, against the standard's safety distances.
     python benchmarks/iso13857.py [--quick] [--bodies p95-male,p50-male] [--flexion 55,90] [--width 8]
                                   [--per-heading 2] [--depth 8] [--spa 4] [--columns 1000,1400]
                                   [--openings-only | --no-openings] [--kernel-steps-only] [--show A,B]
+                                  [--low-risk]
 
 Reach over (Table 2, high risk): for each structure height b of the table's columns, a cell with one straight
 fence panel (bottom 0, top b) across the floor and the worker (``human: {model: articulated, body: ...}``)
@@ -35,7 +36,7 @@ import time
 import numpy as np
 
 from cellstress.cell.load import parse_cell
-from cellstress.core.iso13857 import TABLE_2, TABLE_4, opening_distance
+from cellstress.core.iso13857 import TABLE_1, TABLE_2, TABLE_4, opening_distance
 from cellstress.human.anthropometry import BODY_SIZES
 from cellstress.sim.simulator import Simulator
 
@@ -347,7 +348,9 @@ def run_reach_over(body: str, flexion: float, args, columns, rows) -> dict:
 
 
 def print_reach_over(out, body, flexion, columns, rows, secs, played, args) -> None:
-    print(f"\n### Table 2 (high risk), {body}, trunk flexion up to {flexion:g} deg: c_iso / c_sim [mm]\n")
+    table = args.table
+    print(f"\n### {table.table} ({table.risk} risk), {body}, trunk flexion up to {flexion:g} deg: "
+          f"c_iso / c_sim [mm]\n")
     print("| a \\ b | " + " | ".join(f"{b:g}" for b in columns) + " |")
     print("|---" * (len(columns) + 1) + "|")
     counts = {"agree": 0, "short": 0, "beyond": 0}
@@ -355,7 +358,7 @@ def print_reach_over(out, body, flexion, columns, rows, secs, played, args) -> N
     for a in sorted(rows, reverse=True):
         cells = []
         for b in columns:
-            c_iso, c_sim = TABLE_2.c(a, b), out[a, b][0]
+            c_iso, c_sim = table.c(a, b), out[a, b][0]
             verdict = agreement(c_iso, c_sim)
             counts[verdict] += 1
             cells.append(f"{c_iso:g} / {c_sim:.0f}{mark[verdict]}")
@@ -426,10 +429,12 @@ def main() -> None:
                     help="accept what the kernel accepts (poses checked every time step, not the motion between)")
     ap.add_argument("--openings-only", action="store_true")
     ap.add_argument("--no-openings", action="store_true")
+    ap.add_argument("--low-risk", action="store_true", help="reach over: Table 1 (low risk) instead of Table 2")
     ap.add_argument("--show", default="", help="A,B: print the witness action sequence of one cell")
     args = ap.parse_args()
     args.show = tuple(float(v) for v in args.show.split(",")) if args.show else None
-    columns = [float(v) for v in args.columns.split(",")] if args.columns else list(TABLE_2.b_mm)
+    args.table = TABLE_1 if args.low_risk else TABLE_2
+    columns = [float(v) for v in args.columns.split(",")] if args.columns else list(args.table.b_mm)
     bodies, flexions = args.bodies.split(","), [float(v) for v in args.flexion.split(",")]
     if args.quick:
         columns, bodies, flexions = [1000.0, 1400.0, 2000.0, 2500.0], ["p95-male"], [55.0]
@@ -437,7 +442,7 @@ def main() -> None:
     for body in bodies:
         for flexion in flexions:
             if not args.openings_only:
-                run_reach_over(body, flexion, args, columns, list(TABLE_2.a_mm))
+                run_reach_over(body, flexion, args, columns, list(args.table.a_mm))
             if not args.no_openings and (not args.quick or body == bodies[0]):
                 run_openings(body, flexion, args)
     print(f"\ntotal {time.perf_counter() - t0:.1f} s")
