@@ -11,10 +11,12 @@ computed is more than the articulated worker (or a real person of that size, wit
   the segment x = 0, 0 <= z <= b, and the body has no thickness;
 - the legs stand vertical on the worker's side (hip at x_H <= 0) at any hip height from the deep crouch to
   standing on tiptoe (``POSTURES``; the tiptoe lift is the assumption docs/worker.md names);
-- the trunk is a straight segment of the body's hip-to-shoulder length (0.288 H, human/body.py) that may bend
-  forward by any angle up to ``--flexion`` (default 180 deg: hanging head down over the edge, far past the
-  articulated worker's 55 deg and any measured range of trunk flexion); where it crosses the face it must pass
-  at or above the edge (it may rest on it);
+- the trunk is a straight segment from the hip to the shoulder joint, as long as the worker's own: 0.288 H up
+  the trunk's axis and the shoulder joint's offset to the side (0.259 H / 2 - 0.05 m, human/body.py), since a
+  worker turned sideways to the structure brings the near shoulder that much closer. It may bend forward by any
+  angle up to ``--flexion`` (default 180 deg: hanging head down over the edge, far past the articulated
+  worker's 55 deg and any measured range of trunk flexion); where it crosses the face it must pass at or above
+  the edge (it may rest on it);
 - the arm is a string of the arm's length (upper arm + forearm + hand) plus the hand capsule's radius: no joint
   limits, so it can bend over the edge at any point; its path may not pass through the structure.
 
@@ -44,8 +46,8 @@ import numpy as np
 
 from cellstress.core.iso13857 import TABLE_1, TABLE_2, ReachOverTable
 from cellstress.human.anthropometry import BODY_SIZES, POSTURES, TIPTOE_RISE
+from cellstress.human.body import B_SHOULDER_HALF, B_SHOULDER_RISE, BodyDimensions
 
-SHOULDER_ABOVE_HIP = 0.818 - 0.530  # of stature: shoulder joint 0.818 H, hip 0.530 H (Drillis & Contini)
 HAND_RADIUS = 0.025  # m, the articulated worker's hand capsule (human/articulated.py)
 ONE_STEP_MM = 100.0
 
@@ -62,15 +64,18 @@ class Body2D:
 
     @property
     def top(self) -> float:
-        """The highest point the body touches at all: hip on tiptoe, trunk and arm straight up."""
+        """Above this nothing of the body gets: hip on tiptoe, trunk and arm straight up (the trunk's full hip to
+        shoulder length, more than its rise)."""
         return self.hip_high + self.trunk + self.arm
 
 
 def body_2d(name: str, flexion_deg: float, tiptoe: float, extra_arm: float = 0.0) -> Body2D:
     size = BODY_SIZES[name]
     h = size.stature
+    p = BodyDimensions(h, size.upper_arm, size.forearm, size.hand, walking_speed=1.6, articulated=True).params()
     return Body2D(hip_low=POSTURES["crouch"].hip_height(h), hip_high=POSTURES["stand"].hip_height(h) + tiptoe,
-                  trunk=SHOULDER_ABOVE_HIP * h, arm=size.arm_length + HAND_RADIUS + extra_arm,
+                  trunk=math.hypot(p[B_SHOULDER_RISE], p[B_SHOULDER_HALF]),
+                  arm=size.arm_length + HAND_RADIUS + extra_arm,
                   max_flexion=math.radians(flexion_deg))
 
 
