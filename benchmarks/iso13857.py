@@ -31,14 +31,19 @@ docs/results.md and docs/worker.md discuss the numbers.
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from iso13857_bound import body_2d, c_bound  # noqa: E402
+
 from cellstress.cell.load import parse_cell
-from cellstress.core.iso13857 import TABLE_1, TABLE_2, TABLE_4, opening_distance
-from cellstress.human.anthropometry import BODY_SIZES
-from cellstress.sim.simulator import Simulator
+from cellstress.core.iso13857 import TABLE_1, TABLE_2, TABLE_4, opening_distance  # noqa: E402
+from cellstress.human.anthropometry import BODY_SIZES, TIPTOE_RISE  # noqa: E402
+from cellstress.sim.simulator import Simulator  # noqa: E402
 
 STEP_MM = 100.0  # one step of Table 2's c grid: the agreement tolerance
 START_GAP = 1.12  # m between the start and the closest the feet get (0.2 m) to the fence: 14 walking and 20
@@ -368,6 +373,15 @@ def print_reach_over(out, body, flexion, columns, rows, secs, played, args) -> N
           f"{counts['short']}, beyond (worker reaches further than c + 100 mm) {counts['beyond']}; "
           f"beam width {args.width} per height, depth {args.depth} actions, {args.spa} steps per action, "
           f"{played} sequences played, {secs:.1f} s")
+    # the cells a body of this size can reach at all (benchmarks/iso13857_bound.py, its generous defaults)
+    bound = body_2d(body, 180.0, TIPTOE_RISE)
+    within = {"agree": 0, "short": 0, "beyond": 0}
+    for a in rows:
+        for b in columns:
+            if table.c(a, b) <= 1000.0 * c_bound(bound, a / 1000.0, b / 1000.0)[0] + STEP_MM:
+                within[agreement(table.c(a, b), out[a, b][0])] += 1
+    print(f"{body}: of the {sum(within.values())} cells the body can reach at all (iso13857_bound.py): agree "
+          f"{within['agree']}, short {within['short']}, beyond {within['beyond']}")
 
 
 FITS = ((0.025, "hand"), (0.04, "forearm"), (0.05, "upper arm"))  # capsule radii, human/body.py
