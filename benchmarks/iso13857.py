@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from iso13857_bound import body_2d, c_bound  # noqa: E402
+from iso13857_bound import attainable, body_2d  # noqa: E402
 
 from cellstress.cell.load import parse_cell
 from cellstress.core.iso13857 import TABLE_1, TABLE_2, TABLE_4, opening_distance  # noqa: E402
@@ -378,7 +378,7 @@ def print_reach_over(out, body, flexion, columns, rows, secs, played, args) -> N
     within = {"agree": 0, "short": 0, "beyond": 0}
     for a in rows:
         for b in columns:
-            if table.c(a, b) <= 1000.0 * c_bound(bound, a / 1000.0, b / 1000.0)[0] + STEP_MM:
+            if attainable(bound, table.c(a, b), a, b):
                 within[agreement(table.c(a, b), out[a, b][0])] += 1
     print(f"{body}: of the {sum(within.values())} cells the body can reach at all (iso13857_bound.py): agree "
           f"{within['agree']}, short {within['short']}, beyond {within['beyond']}")

@@ -27,7 +27,7 @@ Two results per cell:
 - **exact**: nothing reaches height a when a is above the highest point the body can touch at all,
   hip on tiptoe + trunk + arm (+ hand radius), straight up. There c_bound = 0 with no approximation;
 - **estimate**: elsewhere c_bound is the maximum over a grid of hip heights, hip positions and trunk angles,
-  refined around the best grid point (steps printed). A grid maximum approaches the model's supremum from
+  refined twice around the best grid point. A grid maximum approaches the model's supremum from
   below, by at most a few millimetres here (the refined step is 1 mm and 0.05 deg).
 
 A cell's standard distance c_iso is **unattainable** for this body when c_iso > c_bound + 100 mm (one step of
@@ -134,6 +134,11 @@ def c_bound(body: Body2D, a: float, b: float) -> tuple[float, bool]:
         if cand > best:
             best, h0, x0, f0 = cand, h1, x1, f1
     return best, False
+
+
+def attainable(body: Body2D, c_iso_mm: float, a_mm: float, b_mm: float) -> bool:
+    """Can a model of this body agree with the standard's c_iso within one step: c_iso <= c_bound + 100 mm?"""
+    return c_iso_mm <= 1000.0 * c_bound(body, a_mm / 1000.0, b_mm / 1000.0)[0] + ONE_STEP_MM
 
 
 def bound_table(body: Body2D, table: ReachOverTable) -> list[list[tuple[float, bool]]]:
