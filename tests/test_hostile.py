@@ -34,22 +34,32 @@ TIME_LIMIT = 300  # s per process: generous for a loaded CI machine; a hang is w
 MEMORY_LIMIT = 6 * 2**30  # bytes of address space per process
 # One process per input: it runs each command that reads the input in turn, each with its own stdout and
 # stderr, and reports exit codes (a crash of the command itself shows as a traceback in its stderr).
+# The process's file descriptor 2 is captured too, command by command: a C library (the URDF parser, numba)
+# writes there past Python's sys.stderr, and a user sees those lines.
 CHILD = f"""
-import contextlib, io, json, resource, sys, traceback
+import contextlib, io, json, os, resource, sys, tempfile, traceback
 resource.setrlimit(resource.RLIMIT_AS, ({MEMORY_LIMIT}, {MEMORY_LIMIT}))
 from cellstress.cli import main
 done = []
+saved = os.dup(2)
 for argv in json.load(open(sys.argv[1])):
     out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            code = main(argv)
-        except SystemExit as exc:
-            code = exc.code
-        except BaseException:
-            traceback.print_exc()
-            code = -1
-    done.append({{"code": code, "out": out.getvalue(), "err": err.getvalue()}})
+    fd2 = tempfile.TemporaryFile()
+    os.dup2(fd2.fileno(), 2)
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                code = main(argv)
+            except SystemExit as exc:
+                code = exc.code
+            except BaseException:
+                traceback.print_exc()
+                code = -1
+    finally:
+        os.dup2(saved, 2)
+    fd2.seek(0)
+    raw = fd2.read().decode("utf-8", "replace")
+    done.append({{"code": code, "out": out.getvalue(), "err": raw + err.getvalue()}})
 json.dump(done, open(sys.argv[2], "w"))
 """
 CELL, RESULT = "in/cell.yaml", "out/result.json"
