@@ -115,8 +115,10 @@ def inflated(layout: Layout, cover: ArrivalCover) -> Layout:
     return dataclasses.replace(layout, params=params)
 
 
-def confirm_phases(phase: float, cover: ArrivalCover) -> tuple[float, ...]:
-    """The arrival moments across the window of ``phase`` at which an alarm is replayed (the grid phase first)."""
+def confirm_phases(phase: float, cover: ArrivalCover, cycle: float) -> tuple[float, ...]:
+    """The arrival moments across the window of ``phase`` at which an alarm is replayed, nearest first, each
+    within the cycle (a moment before 0 is the same moment of the cycle before), rounded to 1 ns as witnesses
+    record them."""
     offsets = np.linspace(-cover.half_window, cover.half_window, CONFIRM_STEPS)
     order = np.argsort(np.abs(offsets), kind="stable")
-    return tuple(round(phase + float(o), 9) for o in offsets[order])
+    return tuple(dict.fromkeys(round((phase + float(o)) % cycle, 9) for o in offsets[order]))

@@ -111,7 +111,9 @@ def _found(sim: Simulator, out: TreeOutcome, phase: float) -> dict[tuple, list]:
 def _confirm(task: Task, wide: TreeOutcome, found: dict[tuple, list]) -> tuple[int, int]:
     """Replay each hazardous sequence of the arrival-window model at moments across the window, in the model
     itself; one hazardous there is a hazard (its class found at that moment). Returns (confirmed, alarms)."""
-    sims = [(p, _simulator(task.cell).with_start(task.start.pose, p)) for p in confirm_phases(task.phase, task.cover)]
+    base = _simulator(task.cell)
+    cycle = float(base.layout.trajectory.cycle)
+    sims = [(p, base.with_start(task.start.pose, p)) for p in confirm_phases(task.phase, task.cover, cycle)]
     confirmed = alarms = 0
     for hit in wide.hits:
         for p, sim in sims:
