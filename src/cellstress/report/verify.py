@@ -99,7 +99,8 @@ def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None
         lines.append(f"note      {sc.horizon} actions per episode, fewer than the cell's own {sc.cell_horizon}: "
                      "contacts after them are not decided")
     for a in sc.approximations:
-        lines.append(f"model     {a.name}: {a.size:g} {a.unit}: {a.what}")
+        size = f" ({a.size:.3g} {a.unit})" if a.size else ""
+        lines.append(f"model     {a.name}{size}: {a.what}")
     hazardous = [s for s in res.subtrees if s.hazardous]
     for s in hazardous[:MAX_LISTED]:
         lines.append(f"  {s.start} at phase {s.phase:g} s: {s.hazardous:,} of {s.sequences:,} hazardous "
@@ -143,7 +144,8 @@ def verify_page(res: VerifyResult, png: str | Path, path: str | Path, criterion_
             H.table(None, [[ln.split(" ", 1)[0], ln.split(" ", 1)[1].strip()] for ln in lines[:3 + len(res.pruned)]]),
             f"<p>{escape(res.scope.statement)}</p>",
             H.table(["approximation", "size", "what"],
-                    [[a.name, f"{a.size:g} {a.unit}", a.what] for a in res.scope.approximations]),
+                    [[a.name, f"{a.size:.3g} {a.unit}" if a.size else "", a.what]
+                     for a in res.scope.approximations]),
             H.figure(png, "Hazard map: arrival phases x start points", "hazard map"),
             "<h2>Sub-trees</h2>",
             H.table(["start", "phase [s]", "verdict", "hazardous", "of", "P(hazard)", "between grid moments",
