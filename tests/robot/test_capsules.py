@@ -6,7 +6,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from cellstress.robot.capsules import fit_capsule, fitted_capsules
+from cellstress.robot.capsule_fit import fit_capsule
+from cellstress.robot.capsules import fitted_capsules
 from cellstress.robot.geometry import robot_geometry
 from cellstress.robot.model import example_robot_data_share
 from cellstress.sim import kernels as K

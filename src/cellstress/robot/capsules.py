@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cellstress.core.errors import CellstressError
+from cellstress.robot.capsule_fit import fit_capsule_to, fit_tight, point_segment_distances
 from cellstress.robot.geometry import LinkGeometry, robot_geometry
 from cellstress.robot.model import RobotModel
 
@@ -37,46 +38,6 @@ class Capsule:
     radius: float
 
 
-def point_segment_distances(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    ab = b - a
-    denom = float(ab @ ab)
-    if denom == 0.0:
-        return np.linalg.norm(points - a, axis=1)
-    t = np.clip((points - a) @ ab / denom, 0.0, 1.0)
-    return np.linalg.norm(points - (a + t[:, None] * ab), axis=1)
-
-
-def fit_capsule(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
-    """An enclosing capsule along the principal axis of ``points`` (n x 3)."""
-    center = points.mean(axis=0)
-    centered = points - center
-    _, _, vt = np.linalg.svd(centered, full_matrices=False)
-    axis = vt[0]
-    t = centered @ axis
-    radial = np.linalg.norm(centered - np.outer(t, axis), axis=1)
-    r = float(radial.max())
-    lo, hi = float(t.min()) + r, float(t.max()) - r
-    if hi < lo:  # short, fat part: a sphere
-        lo = hi = 0.5 * (float(t.min()) + float(t.max()))
-    a, b = center + lo * axis, center + hi * axis
-    r = float(point_segment_distances(points, a, b).max())
-    return a, b, r
-
-
-def fit_capsule_to(points: np.ndarray, balls: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
-    """An enclosing capsule of ``points`` (n x 3) and ``balls`` (k x 4: centre, radius). Without balls it is
-    ``fit_capsule``'s; balls add their axis points to the principal-axis fit and their exact farthest distance
-    (centre's distance plus radius) to the radius."""
-    if balls.shape[0] == 0:
-        return fit_capsule(points)
-    c, r = balls[:, :3], balls[:, 3]
-    axes = np.concatenate([np.eye(3), -np.eye(3)])
-    ball_pts = (c[:, None, :] + r[:, None, None] * axes[None]).reshape(-1, 3)
-    a, b, rad = fit_capsule(np.concatenate([points, ball_pts]))
-    rad = max(rad, float((point_segment_distances(c, a, b) + r).max()))
-    return a, b, rad
-
-
 def _inside(cap: Capsule, g: LinkGeometry) -> bool:
     """Whether every shape of the link lies inside ``cap`` (both in the same joint frame)."""
     a, b = np.asarray(cap.p0), np.asarray(cap.p1)
@@ -88,10 +49,15 @@ def _inside(cap: Capsule, g: LinkGeometry) -> bool:
 
 
 def link_capsule(g: LinkGeometry) -> Capsule:
-    """The capsule enclosing one link's shapes, on the link's joint, named after the link."""
+    """The capsule enclosing one link's shapes, on the link's joint, named after the link: ``fit_capsule``'s
+    for a link of meshes only (the built-in robots' capsules), ``fit_tight`` for a link with a primitive."""
     pts = np.concatenate([s.hull_points() for s in g.shapes])
     balls = np.concatenate([s.balls() for s in g.shapes])
-    a, b, r = fit_capsule_to(pts, balls)
+    if all(s.kind == "mesh" for s in g.shapes):
+        a, b, r = fit_capsule_to(pts, balls)
+    else:
+        directions = np.concatenate([s.axes() for s in g.shapes])
+        a, b, r = fit_tight(pts, balls, directions)
     return Capsule(g.link, g.joint, tuple(a), tuple(b), r)
 
 

@@ -80,6 +80,16 @@ class Shape:
             return np.column_stack([ends, [r, r]])
         return np.zeros((0, 4))
 
+    def axes(self) -> np.ndarray:
+        """The shape's own directions in the joint frame (k x 3): a cylinder's or capsule's axis, a box's three
+        edges; none for a sphere or mesh."""
+        rot = self.pose[:3, :3]
+        if self.kind in ("cylinder", "capsule"):
+            return rot[:, 2:3].T.copy()
+        if self.kind == "box":
+            return rot.T.copy()
+        return np.zeros((0, 3))
+
     def footprint_points(self) -> np.ndarray:
         """Points (joint frame) on the shape whose plan hull lies inside the shape's plan footprint, and whose
         highest is the shape's top: for the robot's base as an obstacle, which must not be larger than the
@@ -183,12 +193,8 @@ def robot_geometry(urdf: Path) -> RobotGeometry:
     return RobotGeometry(urdf, tuple(links))
 
 
-def check_seen(geometry: RobotGeometry, robot: RobotModel) -> None:
-    """CellstressError naming the first moving link with a mass but no shape (see the module docstring)."""
-    unseen = geometry.unseen_links()
-    if unseen:
-        g = unseen[0]
-        raise CellstressError(
-            f"{geometry.urdf}: link {quoted(g.link)} moves (with joint {quoted(robot.joint_names[g.joint])}) and has "
+def unseen_message(geometry: RobotGeometry, robot: RobotModel, g: LinkGeometry) -> str:
+    """The error for a moving link with a mass but no shape (``RobotGeometry.unseen_links``)."""
+    return (f"{geometry.urdf}: link {quoted(g.link)} moves (with joint {quoted(robot.joint_names[g.joint])}) and has "
             f"a mass of {g.mass:g} kg but no <collision> or <visual> shape, so no check could see it; give it a "
-            "shape in the URDF")
+            "shape in the URDF or declare a capsule on it")
