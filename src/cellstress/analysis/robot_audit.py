@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cellstress.robot.geometry import LinkGeometry, RobotGeometry, Shape
+from cellstress.robot.joints import JointMap, chains
 
 SPACING = 0.01  # m between surface samples
 MAX_SAMPLES = 200_000  # per shape: a finer mesh is sampled more coarsely per triangle (at least its corners)
@@ -41,6 +42,7 @@ class RobotAudit:
     links: tuple[LinkAudit, ...]
     frames: tuple[str, ...]  # links without shape and without (or with a negligible) mass
     unshaped_fixed: tuple[str, ...]  # links with a mass but no shape that do not move (the base's parts)
+    branches: tuple[tuple[str, ...], ...] = ()  # the driven joints per branch, when the robot is a tree
 
     @property
     def worst(self) -> float:
@@ -59,6 +61,9 @@ class RobotAudit:
             out.append(f"{a.link:<18} {where:<20} {kind:<26} in {caps}: outside by {_mm(a.outside)}")
         if self.frames:
             out.append(f"frames (no shape, no mass): {', '.join(self.frames)}")
+        if len(self.branches) > 1:
+            out.append(f"a tree: the program drives {len(self.branches)} branches together, in step: "
+                       + " | ".join(", ".join(b) for b in self.branches))
         if self.unshaped_fixed:
             out.append(f"fixed links with a mass but no shape (not part of the base's footprint): "
                        f"{', '.join(self.unshaped_fixed)}")
@@ -190,9 +195,11 @@ def audit_link(g: LinkGeometry, capsules) -> LinkAudit:
     return LinkAudit(g.link, g.joint, g.source, shapes, tuple(c.name for c in mine), worst, n)
 
 
-def audit_robot(geometry: RobotGeometry, capsules) -> RobotAudit:
-    """The audit of every link with a shape, against ``capsules`` (a robot's ``Capsule`` list)."""
+def audit_robot(geometry: RobotGeometry, capsules, jmap: JointMap | None = None) -> RobotAudit:
+    """The audit of every link with a shape, against ``capsules`` (a robot's ``Capsule`` list); with the
+    program's joint map, the branches it drives."""
     links = tuple(audit_link(g, capsules) for g in geometry.links if g.shapes)
     frames = tuple(g.link for g in geometry.links if g.is_frame)
     unshaped = tuple(g.link for g in geometry.links if not g.shapes and not g.is_frame and g.joint < 0)
-    return RobotAudit(links, frames, unshaped)
+    branches = () if jmap is None else tuple(tuple(jmap.robot.joint_names[j] for j in c) for c in chains(jmap))
+    return RobotAudit(links, frames, unshaped, branches)

@@ -27,7 +27,7 @@ def check(
         spec = c.spec
         layout = build_layout(c)
         static = check_cell(c, layout)
-        audits = [audit_robot(robot_geometry(p.model.urdf), p.capsules) for p in layout.robots]
+        audits = [audit_robot(robot_geometry(p.model.urdf), p.capsules, p.joints) for p in layout.robots]
 
     out = say
     where = f"built-in: {builtin_file(cell)}" if cell in BUILTIN_CELLS else f"file: {c.source}"

@@ -104,7 +104,7 @@ class Shape:
             return local @ self.pose[:3, :3].T + self.pose[:3, 3]
         out = []
         for *c, r in self.balls():
-            out += [np.asarray(c) + r * ring, np.asarray(c) + [0.0, 0.0, r]]  # the horizontal great circle, top
+            out += [np.asarray(c) + r * ring, (np.asarray(c) + [0.0, 0.0, r])[None]]  # the horizontal great circle, top
         return np.concatenate(out)
 
 
