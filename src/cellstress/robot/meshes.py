@@ -24,7 +24,7 @@ import numpy as np
 
 from cellstress.core.errors import CellstressError
 from cellstress.core.io import InputFileError, read_input_bytes
-from cellstress.robot.urdf_file import MAX_EXTENT, captured_fd2, parser_reason
+from cellstress.robot.urdf_file import MAX_EXTENT, captured_fd2
 
 MAX_MESH_BYTES = 32 * 1024 * 1024  # example-robot-data's largest mesh (Go1's trunk.dae) is 28.8 MB
 MAX_MESH_TRIANGLES = 400_000  # per file (that trunk: 351,394)
@@ -109,11 +109,13 @@ def _with_coal(path: Path, data: bytes, scale: np.ndarray) -> tuple[np.ndarray, 
     with tempfile.TemporaryDirectory(prefix="cellstress-mesh-") as tmp:
         copy = Path(tmp) / ("mesh" + path.suffix.lower())
         copy.write_bytes(data)
-        with captured_fd2() as said:
+        with captured_fd2():
             try:
                 model = coal.MeshLoader().load(str(copy), scale)
-            except Exception as exc:  # noqa: BLE001 - assimp reports any unreadable file as a plain exception
-                raise MeshError(path, f"cannot be read as a mesh: {parser_reason(said, exc)}") from None
+            except Exception:  # noqa: BLE001 - assimp reports any unreadable file as a plain exception
+                # (its text names our private copy and coal's source lines, not the cause)
+                raise MeshError(path, f"cannot be read as a mesh in the {path.suffix.lower()} format (assimp finds none "
+                                      "in it)") from None
     n = int(model.num_tris)
     if n > MAX_MESH_TRIANGLES:
         raise MeshError(path, f"has {n:,} triangles; cellstress reads at most {MAX_MESH_TRIANGLES:,} per mesh")

@@ -1,8 +1,9 @@
 """A serial robot from a URDF, loaded with pinocchio and flattened into arrays for the compiled simulator.
 
-Pinocchio gives the kinematic tree (joint placements, axes, limits) and the collision meshes. We keep the
-chain as plain arrays so that the numba kernel can do forward kinematics without Python objects, and the tests
-check that kernel against pinocchio itself.
+Pinocchio gives the kinematic tree (joint placements, axes, limits), from the URDF text ``robot.urdf_file``
+has checked first; the links' shapes are ``robot.geometry``'s. We keep the tree as plain arrays so that the
+numba kernel can do forward kinematics without Python objects, and the tests check that kernel against
+pinocchio itself.
 """
 
 from __future__ import annotations
@@ -216,9 +217,11 @@ def load_robot(urdf: Path) -> RobotModel:
     for name, v, lo, hi, cont in zip(names, vmax, lower, upper, continuous, strict=True):
         if not (np.isfinite(v) and v > 0.0):
             raise CellstressError(f"{urdf}: joint {name!r} has no velocity limit (<limit velocity=...> > 0)")
-        if not cont and not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
+        if not cont and not (np.isfinite(lo) and np.isfinite(hi)):
             raise CellstressError(f"{urdf}: joint {name!r} has no finite position limits (<limit lower=... "
                                   "upper=...>)")
+        if not cont and lo > hi:
+            raise CellstressError(f"{urdf}: joint {name!r}: its lower limit {lo:g} is above its upper limit {hi:g}")
     master, mult, off = _mimic_arrays(urdf, names)
     link_joint: dict[str, int] = {}
     link_in_joint: dict[str, np.ndarray] = {}
