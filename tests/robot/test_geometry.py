@@ -97,10 +97,11 @@ def random_primitive_robot(folder: Path, rng) -> Path:
     links, joints = [], []
     for i in range(5):
         shapes = ""
-        for k in range(int(rng.integers(1, 4))):
+        for _ in range(int(rng.integers(1, 4))):
             kind = kinds[int(rng.integers(4))]
             size = {"box": f'<box size="{" ".join(f"{v:.3f}" for v in rng.uniform(0.02, 0.4, 3))}"/>',
-                    "cylinder": f'<cylinder radius="{rng.uniform(0.01, 0.1):.3f}" length="{rng.uniform(0.02, 0.5):.3f}"/>',
+                    "cylinder": f'<cylinder radius="{rng.uniform(0.01, 0.1):.3f}" '
+                                f'length="{rng.uniform(0.02, 0.5):.3f}"/>',
                     "sphere": f'<sphere radius="{rng.uniform(0.01, 0.15):.3f}"/>',
                     "capsule": f'<capsule radius="{rng.uniform(0.01, 0.1):.3f}" length="{rng.uniform(0.0, 0.4):.3f}"/>'}
             xyz, rpy = rng.uniform(-0.2, 0.2, 3), rng.uniform(-3, 3, 3)

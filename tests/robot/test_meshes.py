@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from cellstress.robot.meshes import MAX_MESH_TRIANGLES, MeshError, read_mesh
-from cellstress.robot.urdf_file import MAX_EXTENT
 from cellstress.robot.model import BUILTIN_ROBOTS, mesh_paths, resolve_urdf
+from cellstress.robot.urdf_file import MAX_EXTENT
 
 TRI = [((0.0, 0.0, 0.0), (0.1, 0.0, 0.0), (0.0, 0.1, 0.0)), ((0.0, 0.0, 0.0), (0.0, 0.1, 0.0), (0.0, 0.0, 0.1))]
 
@@ -54,8 +54,9 @@ def test_stl_reader_is_coals_bit_for_bit(scale):
 
 
 def test_ascii_stl_and_obj(tmp_path):
-    text = "solid t\n" + "".join("facet normal 0 0 0\n outer loop\n" + "".join(f"  vertex {x} {y} {z}\n" for x, y, z in t)
-                                 + " endloop\nendfacet\n" for t in TRI) + "endsolid t\n"
+    facets = ["facet normal 0 0 0\n outer loop\n" + "".join(f"  vertex {x} {y} {z}\n" for x, y, z in t)
+              + " endloop\nendfacet\n" for t in TRI]
+    text = "solid t\n" + "".join(facets) + "endsolid t\n"
     (tmp_path / "a.stl").write_text(text)
     m = read_mesh(tmp_path / "a.stl")
     assert m.vertices.shape == (4, 3) and m.triangles.shape == (2, 3)
@@ -93,7 +94,8 @@ def _case(tmp_path: Path, name: str, data: bytes) -> Path:
 ])
 def test_unusable_meshes_are_refused(tmp_path, name, make, says):
     if name == "many.stl":  # a header and size that agree, beyond the limit: refused before reading a triangle
-        make = binary_stl(TRI[:1]) [:80] + struct.pack("<I", MAX_MESH_TRIANGLES + 1) + b"\0" * 50 * (MAX_MESH_TRIANGLES + 1)
+        n = MAX_MESH_TRIANGLES + 1
+        make = b"\0" * 80 + struct.pack("<I", n) + b"\0" * 50 * n
     path = tmp_path / name if make is None else _case(tmp_path, name, make)
     with pytest.raises(MeshError) as err:
         read_mesh(path)

@@ -18,8 +18,8 @@ def check(
     a valid cell."""
     from cellstress.analysis.iso13855 import check_cell
     from cellstress.analysis.robot_audit import audit_robot
-    from cellstress.robot.geometry import robot_geometry
     from cellstress.cell.load import BUILTIN_CELLS, builtin_file, load_cell
+    from cellstress.robot.geometry import robot_geometry
     from cellstress.sim.build import build_layout
 
     with spinner_while_compiling(), user_errors():

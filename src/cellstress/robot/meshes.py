@@ -114,8 +114,8 @@ def _with_coal(path: Path, data: bytes, scale: np.ndarray) -> tuple[np.ndarray, 
                 model = coal.MeshLoader().load(str(copy), scale)
             except Exception:  # noqa: BLE001 - assimp reports any unreadable file as a plain exception
                 # (its text names our private copy and coal's source lines, not the cause)
-                raise MeshError(path, f"cannot be read as a mesh in the {path.suffix.lower()} format (assimp finds none "
-                                      "in it)") from None
+                raise MeshError(path, f"cannot be read as a mesh in the {path.suffix.lower()} format (assimp "
+                                      "finds none in it)") from None
     n = int(model.num_tris)
     if n > MAX_MESH_TRIANGLES:
         raise MeshError(path, f"has {n:,} triangles; cellstress reads at most {MAX_MESH_TRIANGLES:,} per mesh")

@@ -265,8 +265,8 @@ def _check_tree(urdf: Path, names: list[str], edges: list[tuple[str, str, str]])
     children: dict[str, list[str]] = {}
     for joint, parent, child in edges:
         if child in parent_of:
-            raise _fail(urdf, f"link {quoted(child)}", f"is the child of two joints ({quoted(parent_of[child])} and {quoted(joint)}); "
-                                                 "a URDF is a tree")
+            raise _fail(urdf, f"link {quoted(child)}", f"is the child of two joints ({quoted(parent_of[child])} and "
+                                                       f"{quoted(joint)}); a URDF is a tree")
         parent_of[child] = joint
         children.setdefault(parent, []).append(child)
     roots = [n for n in names if n not in parent_of]
@@ -332,7 +332,8 @@ def parse_urdf(urdf: Path, data: bytes) -> UrdfDoc:
             raise _fail(urdf, f"link {quoted(name)}", "is defined twice")
         names.append(name)
         masses[name] = _check_link(urdf, link, name)
-        collision[name] = tuple(_shape(urdf, name, "collision", i, el) for i, el in enumerate(link.findall("collision")))
+        collision[name] = tuple(_shape(urdf, name, "collision", i, el)
+                                for i, el in enumerate(link.findall("collision")))
         visual[name] = tuple(_shape(urdf, name, "visual", i, el) for i, el in enumerate(link.findall("visual")))
     joint_names = [j.get("name", "") for j in joint_els]
     edges = []
