@@ -22,7 +22,7 @@ from cellstress.robot.geometry import LinkGeometry, RobotGeometry, Shape
 from cellstress.robot.joints import JointMap, chains
 
 SPACING = 0.01  # m between surface samples
-MAX_SAMPLES = 200_000  # per shape: a finer mesh is sampled more coarsely per triangle (at least its corners)
+MAX_SAMPLES = 100_000  # per shape: a finer mesh is sampled more coarsely per triangle (at least its corners)
 OUTSIDE_TOL = 1e-9  # m: round-off; anything above is reported as outside
 
 
