@@ -110,9 +110,13 @@ def test_resolve_mesh(tmp_path):
 def test_mesh_paths_of_a_short_name_robot():
     from cellstress.robot.model import resolve_urdf
 
+    from cellstress.robot.geometry import robot_geometry
+
     paths = mesh_paths(resolve_urdf("ur10", None))
     assert len(paths) == 14 and all(p.is_file() for p in paths)  # 7 collision STL, 7 visual DAE
     assert len(set(paths)) == len(paths)
+    read = robot_geometry(resolve_urdf("ur10", None)).mesh_files()
+    assert read == paths[:7] and all(p.suffix == ".stl" for p in read)  # only the collision meshes are read
 
 
 def test_file_descriptor_2_is_captured():

@@ -132,6 +132,16 @@ class RobotGeometry:
     def moving(self) -> tuple[LinkGeometry, ...]:
         return tuple(g for g in self.links if g.joint >= 0)
 
+    def mesh_files(self) -> tuple[Path, ...]:
+        """The mesh files read for the shapes (each once, in order): a subset of ``model.mesh_paths``, which
+        also lists visual meshes of links that have collision shapes, never read."""
+        out: dict[Path, None] = {}
+        for g in self.links:
+            for s in g.shapes:
+                if s.mesh is not None:
+                    out.setdefault(s.mesh.path, None)
+        return tuple(out)
+
     def unseen_links(self) -> tuple[LinkGeometry, ...]:
         """Moving links with a mass but no shape: parts of the robot nobody described."""
         return tuple(g for g in self.moving() if not g.shapes and not g.is_frame)
