@@ -65,7 +65,7 @@ BAD: list[tuple[str, str | bytes, str]] = [
     ("origin-words", chain(1, '<origin xyz="a b c"/>'), "is not 3 numbers"),
     ("origin-two", chain(1, '<origin xyz="1 2"/>'), "has 2 values, not 3"),
     ("unknown-type", chain(1).replace('type="revolute"', 'type="ball"'), "has type 'ball'"),
-    ("box-negative", BOXARM.replace('size="0.08 0.08 0.14"', 'size="0.08 -0.08 0.14"'), "sizes must be positive"),
+    ("box-negative", BOXARM.replace('size="0.08 0.08 0.46"', 'size="0.08 -0.08 0.46"'), "sizes must be positive"),
     ("radius-huge", BOXARM.replace('radius="0.095"', 'radius="1e9"'), "at most 100 m"),
     ("mesh-no-file", BOXARM.replace(FOREARM, '<collision><geometry><mesh/></geometry></collision>'), "no filename"),
     ("mesh-scale-zero", BOXARM.replace(FOREARM, '<collision><geometry><mesh filename="a.stl" scale="0 1 1"/>'
