@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from cellstress.core.errors import CellstressError
-from cellstress.robot.model import load_pinocchio, mesh_paths
+from cellstress.robot.geometry import robot_geometry
+from cellstress.robot.model import load_pinocchio, mesh_paths, resolve_urdf
 from cellstress.robot.urdf_file import (
     MAX_URDF_JOINTS,
     captured_fd2,
@@ -108,10 +109,6 @@ def test_resolve_mesh(tmp_path):
 
 
 def test_mesh_paths_of_a_short_name_robot():
-    from cellstress.robot.model import resolve_urdf
-
-    from cellstress.robot.geometry import robot_geometry
-
     paths = mesh_paths(resolve_urdf("ur10", None))
     assert len(paths) == 14 and all(p.is_file() for p in paths)  # 7 collision STL, 7 visual DAE
     assert len(set(paths)) == len(paths)
