@@ -1,21 +1,21 @@
 """Collision capsules of the robot links: fitted to each link's shapes, or declared in the cell file.
 
-A fitted capsule encloses its link's shapes (``robot.geometry``: collision shapes, else visual ones); how its
-axis and ends are chosen is ``robot.capsule_fit``'s (the original principal-axis fit for a link of meshes, a
-least-volume search for a link with primitives), and its radius is always the largest distance of the shapes
-from the chosen segment. Enclosing (not approximating) keeps the distance d_HR conservative: the simulated
-robot is never thinner than the real one. Why enclosing the points suffices: a capsule (the points within r of
-a segment) is convex, since the distance to a segment is a convex function; a convex set that contains some
-points contains their convex hull. A mesh lies in the hull of its vertices, a box is the hull of its 8 corners, a cylinder
-lies in the prism on the regular 64-gon circumscribing its rims (whose corners are fitted), and a sphere or a
-capsule shape is the hull of its end balls, whose farthest point from the segment is exactly the ball
-centre's distance plus its radius (the point of the ball straight away from the segment's nearest point).
-So containing those points and balls contains the solid shape, and the audit (``analysis.robot_audit``)
-checks it independently on dense samples of the true surfaces.
+A fitted capsule encloses its link's shapes (``robot.geometry``: collision shapes, else visual ones); how its axis
+and ends are chosen is ``robot.capsule_fit``'s (the original principal-axis fit for a link of meshes, a
+least-volume search for a link with primitives), and its radius is always the largest distance of the shapes from the
+chosen segment. Enclosing (not approximating) keeps the distance d_HR conservative: the simulated robot is never
+thinner than the real one. Why enclosing the points suffices: a capsule (the points within r of a segment) is
+convex, since the distance to a segment is a convex function; a convex set that contains some points contains
+their convex hull. A mesh lies in the hull of its vertices, a box is the hull of its 8 corners, a cylinder lies in
+the prism on the regular 64-gon circumscribing its rims (whose corners are fitted), and a sphere or a capsule
+shape is the hull of its end balls, whose farthest point from the segment is exactly the ball centre's distance
+plus its radius (the point of the ball straight away from the segment's nearest point). So containing those points
+and balls contains the solid shape, and the audit (``analysis.robot_audit``) checks it independently on dense
+samples of the true surfaces.
 
 A link whose shapes lie inside one capsule already fitted on the same joint (the UR arms' 1 cm cube on
-``ee_link``, inside the wrist's capsule) gets no capsule of its own: the robot is enclosed just the same, and
-the built-in robots keep their capsules.
+``ee_link``, inside the wrist's capsule) gets no capsule of its own: the robot is enclosed just the same, and the
+built-in robots keep their capsules.
 """
 
 from __future__ import annotations
