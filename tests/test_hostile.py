@@ -256,6 +256,129 @@ BAD_CELLS: list[tuple[str, dict, tuple[str, ...]]] = [
 ]
 
 
+# ---- robot files (issue 29; helper robotgeo): URDFs and meshes from hostile users ---------------------------
+# The baseline with its robot replaced by the built-in primitive arm as in/robot.urdf, changed per case (and
+# mesh files beside it). Every command that reads a cell refuses each with one error line that names the file
+# and the cause in our words (pinocchio's own lines on file descriptor 2 are captured), before any parser that
+# could crash or take unbounded time sees it.
+_ARM = resources.files("cellstress.cell").joinpath("builtin", "boxarm.urdf").read_text(encoding="utf-8")
+_FOREARM = ('<collision><origin xyz="0 0 0.286" rpy="0 0 0"/><geometry><cylinder radius="0.05" length="0.572"/>'
+            "</geometry></collision>")
+_TRIS = [((0.0, 0.0, 0.0), (0.1, 0.0, 0.0), (0.0, 0.1, 0.0)), ((0.0, 0.0, 0.0), (0.0, 0.1, 0.0), (0.0, 0.0, 0.1))]
+
+
+def _stl(triangles, count: int | None = None) -> bytes:
+    import struct
+
+    rows = b"".join(struct.pack("<12fH", 0, 0, 0, *[c for v in t for c in v], 0) for t in triangles)
+    return b"\0" * 80 + struct.pack("<I", len(triangles) if count is None else count) + rows
+
+
+def _sparse_stl(rel: str, n: int) -> Callable[[Path], None]:
+    """A binary STL whose header and size agree on n triangles, written sparse (100 MB cost nothing)."""
+    def setup(folder: Path) -> None:
+        with (folder / rel).open("wb") as fh:
+            fh.write(b"\0" * 80 + n.to_bytes(4, "little"))
+            fh.truncate(84 + 50 * n)
+
+    return setup
+
+
+def _robot(urdf: str | bytes, *more: Callable[[Path], None], cell: Callable[[dict], None] | None = None) -> dict:
+    data = urdf.encode("utf-8") if isinstance(urdf, str) else urdf
+
+    def setup(folder: Path) -> None:
+        _write("in/robot.urdf", data)(folder)
+        for m in more:
+            m(folder)
+
+    def change(doc: dict) -> None:
+        _set("robot.urdf", "robot.urdf")(doc)
+        if cell is not None:
+            cell(doc)
+
+    return {"cell": change, "setup": setup}
+
+
+def _arm_mesh(filename: str) -> str:
+    return _ARM.replace(_FOREARM, f'<collision><geometry><mesh filename="{filename}"/></geometry></collision>')
+
+
+def _chain(n: int) -> str:
+    joints = "".join(f'<link name="l{i + 1}"/><joint name="j{i}" type="revolute"><parent link="l{i}"/><child '
+                     f'link="l{i + 1}"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/>'
+                     "</joint>" for i in range(n))
+    return f'<?xml version="1.0"?><robot name="r"><link name="l0"/>{joints}</robot>'
+
+
+def _baxter_poses(doc: dict) -> None:
+    from cellstress.robot.model import example_robot_data_share
+
+    doc["robot"]["urdf"] = str(example_robot_data_share() / "robots/baxter_description/urdf/baxter.urdf")
+    doc["robot"]["extra_capsules"] = []
+    doc["robot"]["task"] = {"tool_frame": "left_gripper", "poses": [
+        {"xyz": [0.6, 0.3, 1.0], "rpy_deg": [180, 0, 0]}, {"xyz": [0.6, -0.3, 1.0], "rpy_deg": [180, 0, 0]}]}
+
+
+BAD_ROBOT_FILES: list[tuple[str, dict, tuple[str, ...]]] = [
+    ("mesh-missing", _robot(_arm_mesh("nothere.stl")), ("robot.urdf", "forearm_link", "nothere.stl", "no such file")),
+    ("mesh-etc-passwd", _robot(_arm_mesh("/etc/passwd")), ("robot.urdf", "/etc/passwd", "without an extension")),
+    ("mesh-passwd-as-stl", _robot(_arm_mesh("passwd.stl"), _link("in/passwd.stl", "/etc/passwd")),
+     ("passwd.stl", "is not an STL file")),
+    ("mesh-dev-zero", _robot(_arm_mesh("zero.stl"), _link("in/zero.stl", "/dev/zero")),
+     ("zero.stl", "not a regular file")),
+    ("mesh-dev-zero-path", _robot(_arm_mesh("/dev/zero")), ("/dev/zero", "without an extension")),
+    ("mesh-fifo", _robot(_arm_mesh("pipe.stl"), _fifo("in/pipe.stl")), ("pipe.stl", "not a regular file")),
+    ("mesh-directory", _robot(_arm_mesh("dir.stl"), lambda f: (f / "in" / "dir.stl").mkdir()),
+     ("dir.stl", "directory")),
+    ("mesh-0-triangles", _robot(_arm_mesh("m.stl"), _write("in/m.stl", _stl([]))), ("m.stl", "no triangles")),
+    ("mesh-degenerate", _robot(_arm_mesh("m.stl"), _write("in/m.stl", _stl([((0, 0, 0), (0.1, 0, 0), (0.2, 0, 0))]))),
+     ("m.stl", "zero area")),
+    ("mesh-header-10M", _robot(_arm_mesh("m.stl"), _write("in/m.stl", _stl(_TRIS, count=10_000_000))),
+     ("m.stl", "header says 10,000,000 triangles")),
+    ("mesh-nan", _robot(_arm_mesh("m.stl"), _write("in/m.stl", _stl([((0, 0, 0), (math.nan, 0, 0), (0, 1, 0))]))),
+     ("m.stl", "not finite")),
+    ("mesh-inf", _robot(_arm_mesh("m.stl"), _write("in/m.stl", _stl([((0, 0, 0), (0, math.inf, 0), (0, 1, 0))]))),
+     ("m.stl", "not finite")),
+    ("mesh-1e30", _robot(_arm_mesh("m.stl"), _write("in/m.stl", _stl([((0, 0, 0), (1e30, 0, 0), (0, 1, 0))]))),
+     ("m.stl", "1e+30 m from its origin")),
+    ("mesh-100MB", _robot(_arm_mesh("m.stl"), _sparse_stl("in/m.stl", 2_000_000)), ("m.stl", "too large")),
+    ("mesh-500k-triangles", _robot(_arm_mesh("m.stl"), _sparse_stl("in/m.stl", 500_000)),
+     ("m.stl", "500,000 triangles", "at most 400,000")),
+    ("mesh-dae-junk", _robot(_arm_mesh("m.dae"), _write("in/m.dae", b"<COLLADA>junk")),
+     ("m.dae", "cannot be read as a mesh")),
+    ("mesh-dae-entities", _robot(_arm_mesh("m.dae"), _write("in/m.dae", b'<?xml version="1.0"?><!DOCTYPE c '
+                                                                      b'[<!ENTITY a "aaaa">]><COLLADA>&a;</COLLADA>')),
+     ("m.dae", "entities")),
+    ("mesh-format-unknown", _robot(_arm_mesh("m.blend"), _write("in/m.blend", b"BLENDER")), ("m.blend", "'.blend'")),
+    ("urdf-nan-limit", _robot(_ARM.replace('upper="3.14159265359"', 'upper="nan"')),
+     ("robot.urdf", "elbow_joint", "<limit upper>", "not finite")),
+    ("urdf-inf-limit", _robot(_ARM.replace('velocity="3.15"', 'velocity="-inf"')), ("<limit velocity>", "not finite")),
+    ("urdf-cycle", _robot(_ARM.replace("</robot>", '<joint name="loop" type="fixed"><parent link="gripper"/>'
+                                                   '<child link="base_link"/></joint></robot>')), ("cycle",)),
+    ("urdf-two-parents", _robot(_ARM.replace("</robot>", '<joint name="loop" type="fixed"><parent link="gripper"/>'
+                                                         '<child link="shoulder_link"/></joint></robot>')),
+     ("shoulder_link", "child of two joints")),
+    ("urdf-disconnected", _robot(_ARM.replace("</robot>", '<link name="loose"/></robot>')),
+     ("not connected", "loose")),
+    ("urdf-duplicate-link", _robot(_ARM.replace('<link name="tool0"/>', '<link name="tool0"/><link name="tool0"/>')),
+     ("tool0", "defined twice")),
+    ("urdf-empty", _robot(""), ("robot.urdf", "is empty")),
+    ("urdf-utf16", _robot(_ARM.encode("utf-16")), ("robot.urdf", "UTF-16")),
+    ("urdf-10000-joints", _robot(_chain(10_000)), ("robot.urdf", "10,000 joints", "at most 500")),
+    ("urdf-axis-zero", _robot(_ARM.replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>', 1)),
+     ("shoulder_pan_joint", "<axis xyz>", "is zero")),
+    ("urdf-origin-1e30", _robot(_ARM.replace('xyz="0.0 0.1149 0.0"', 'xyz="1e30 0 0"')),
+     ("wrist_2_joint", "<origin xyz>", "100 m")),
+    ("urdf-moving-mass-without-shape", _robot(_ARM.replace(_FOREARM, "")),
+     ("forearm_link", "3.9 kg", "no <collision> or <visual> shape")),
+    ("urdf-no-shape-at-all", _robot(_chain(6), cell=_set("robot.task.waypoints_deg", [[0] * 6, [10] * 6])),
+     ("no link has a <collision> or <visual> shape",)),
+    ("tree-robot-tool-poses", {"cell": _baxter_poses}, ("robot.task.poses", "branches", "robot.hold")),
+]
+BAD_CELLS += BAD_ROBOT_FILES
+
+
 def _cell_cases() -> list[Case]:
     out = []
     for name, spec, says in BAD_CELLS:
@@ -412,6 +535,16 @@ OPTIONS: list[Case] = [
 ]
 
 CASES = _cell_cases() + _result_cases() + NAMED + OPTIONS
+# robot files that are strange but valid (robotgeo): a robot of URDF primitives only (boxes, cylinders and a
+# capsule urdfdom does not know) passes check, with no stray line from the URDF parser
+_PRIMITIVE_ARM = _robot(_ARM.replace(_FOREARM, '<collision><origin xyz="0 0 0.286"/><geometry><capsule radius="0.05" '
+                                                'length="0.47"/></geometry></collision>'))
+CASES += [Case("robot-primitives-only-check", ("check", CELL), 0, group="robot-primitives-only", **_PRIMITIVE_ARM,
+               check=lambda folder, out, err: (err == "" or pytest.fail(err), "outside by 0.000 mm" in out
+                                               or pytest.fail(out[-2000:]))),
+          Case("robot-primitives-only-show", ("show", CELL, "--out", "out/cell.png"), 0, group="robot-primitives-only",
+               **_PRIMITIVE_ARM, check=lambda folder, out, err: (folder / "out" / "cell.png").is_file()
+               or pytest.fail("no picture"))]
 
 
 def _snapshot(folder: Path) -> dict[str, bytes | str]:

@@ -6,8 +6,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from cellstress.robot.capsules import fit_capsule, fitted_capsules
-from cellstress.robot.model import collision_vertices, example_robot_data_share
+from cellstress.robot.capsule_fit import fit_capsule
+from cellstress.robot.capsules import fitted_capsules
+from cellstress.robot.geometry import robot_geometry
+from cellstress.robot.model import example_robot_data_share
 from cellstress.sim import kernels as K
 
 ENCLOSE_TOL = 1e-9  # m; round-off only: the fit is meant to enclose exactly
@@ -33,7 +35,9 @@ def robot(baseline_sim):
 
 @pytest.fixture(scope="module")
 def meshes(robot):
-    return collision_vertices(robot.urdf)
+    """Each link's collision-mesh vertices in its joint's frame."""
+    return {g.link: np.concatenate([s.hull_points() for s in g.shapes]) for g in robot_geometry(robot.urdf).links
+            if any(s.kind == "mesh" for s in g.shapes)}
 
 
 @pytest.fixture(scope="module")

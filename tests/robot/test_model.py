@@ -113,7 +113,7 @@ def test_mimic_with_multiplier_and_offset(tmp_path):
 
 def test_mimic_of_an_unknown_joint(tmp_path):
     path = urdf(tmp_path, [("a", "revolute", "0 0 0.3", "0 0 0", "0 0 1", '<mimic joint="zz"/>')])
-    with pytest.raises(CellstressError, match="mimics 'zz', which is not a joint"):
+    with pytest.raises(CellstressError, match="<mimic>: names joint 'zz', which the URDF does not define"):
         load_robot(path)
 
 

@@ -25,6 +25,8 @@ from cellstress.core.protocols import Channels
 from cellstress.core.records import Channel
 from cellstress.devices.base import stops_of
 from cellstress.human.body import BODY_RADIUS, WALK_BLOCK_HEIGHT
+from cellstress.robot.capsules import fitted_capsules
+from cellstress.robot.geometry import robot_geometry, unseen_message
 from cellstress.robot.model import load_robot, resolve_urdf, unknown_urdf_message
 
 BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap", "all-flaws",
@@ -32,7 +34,7 @@ BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intr
                                   "warning-field-ok", "mat-short", "mat-ok", "palletizing", "palletizing-fixed",
                                   "door-unlocked", "door-locked", "muting-long", "muting-ok",
                                   "two-robots", "two-robots-fixed", "ssm-latency", "ssm-ok", "reach-over",
-                                  "reach-over-ok")
+                                  "reach-over-ok", "long-gripper", "long-gripper-ok")
 
 
 @dataclass(frozen=True)
@@ -368,6 +370,7 @@ def _check_robot(cell: Cell, rs, where: str) -> None:
         raise CellError(src, f"{where}.urdf", str(exc)) from None
     except Exception as exc:  # pinocchio raises plain RuntimeError/ValueError for unreadable URDFs
         raise CellError(src, f"{where}.urdf", f"pinocchio cannot read it: {str(exc).splitlines()[0]}") from None
+    _check_shapes(cell, rs, where, urdf, robot)
     try:
         robot_program(src, robot, rs, cell.files_dir)
     except CellError as exc:  # the program's messages name the field from "robot."
@@ -381,6 +384,22 @@ def _check_robot(cell: Cell, rs, where: str) -> None:
                      else f"{where}.extra_capsules[{i - len(caps)}].link")
             raise CellError(src, field, f"the robot has no link {c.link!r}; its links are "
                                         f"{', '.join(sorted(robot.link_joint))}")
+
+
+def _check_shapes(cell: Cell, rs, where: str, urdf: Path, robot) -> None:
+    """Every shape of the robot readable (meshes within bounds), and no moving part invisible: a moving link
+    with a mass but no shape is refused unless the cell declares a capsule on it; fitted capsules need a shape
+    somewhere."""
+    declared = {c.link for c in (rs.capsules if rs.capsules != "auto" else ()) + rs.extra_capsules}
+    try:
+        geometry = robot_geometry(urdf)
+        unseen = [g for g in geometry.unseen_links() if g.link not in declared]
+        if unseen:
+            raise CellstressError(unseen_message(geometry, robot, unseen[0]))
+        if rs.capsules == "auto":
+            fitted_capsules(robot)
+    except CellstressError as exc:
+        raise CellError(cell.source, f"{where}.urdf", str(exc)) from None
 
 
 def _check_robot_names(cell: Cell) -> None:

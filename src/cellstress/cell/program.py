@@ -15,7 +15,15 @@ from cellstress.cell.schema import MAX_CYCLE, RobotSpec
 from cellstress.core.errors import CellError, CellstressError
 from cellstress.robot.ik import Unreachable, solve_poses
 from cellstress.robot.joint_file import JointFileError, read_joint_file
-from cellstress.robot.joints import JointMap, describe_limit, joint_map, limit_violation, user_value
+from cellstress.robot.joints import (
+    JointMap,
+    ancestors_or_self,
+    branching,
+    describe_limit,
+    joint_map,
+    limit_violation,
+    user_value,
+)
 from cellstress.robot.model import REVOLUTE, RobotModel, base_matrix
 from cellstress.robot.trajectory import Trajectory, build_trajectory, linear_trajectory
 
@@ -99,6 +107,7 @@ def waypoint_program(src: str, jmap: JointMap, spec: RobotSpec, directory: Path 
 def _solve_poses(src: str, jmap: JointMap, spec: RobotSpec) -> np.ndarray:
     task, robot = spec.task, jmap.robot
     driven = list(jmap.driven)
+    _check_one_chain(src, jmap, task.tool_frame)
     if task.ik_seed_deg is not None:
         if len(task.ik_seed_deg) != len(driven):
             raise CellError(src, "robot.task.ik_seed_deg", f"has {len(task.ik_seed_deg)} values; the program "
@@ -118,6 +127,23 @@ def _solve_poses(src: str, jmap: JointMap, spec: RobotSpec) -> np.ndarray:
                         "(at most 1 mm and 1 deg)") from None
     except CellstressError as exc:
         raise CellError(src, "robot.task.tool_frame", str(exc)) from None
+
+
+def _check_one_chain(src: str, jmap: JointMap, tool_frame: str) -> None:
+    """Tool poses decide only the joints that carry the tool frame; on a tree robot (two arms on one torso) the
+    other branches' joints would be left to the solver's start values, so such a program is refused."""
+    robot = jmap.robot
+    pair = branching(jmap)
+    if pair is None or tool_frame not in robot.link_joint:
+        return
+    carriers = ancestors_or_self(robot, robot.link_joint[tool_frame])
+    free = [robot.joint_names[j] for j in jmap.driven if j not in carriers]
+    shown = ", ".join(free[:4]) + (", ..." if len(free) > 4 else "")
+    raise CellError(src, "robot.task.poses", f"the robot branches (joints {robot.joint_names[pair[0]]!r} and "
+                                             f"{robot.joint_names[pair[1]]!r} are on separate branches) and tool "
+                                             f"poses of {tool_frame!r} decide only the joints that carry it, not "
+                                             f"{len(free)} others ({shown}): hold those (robot.hold) or give joint "
+                                             "waypoints or a trajectory file for every joint")
 
 
 def _pose_matrix(xyz, rpy_deg) -> np.ndarray:

@@ -200,18 +200,20 @@ class RobotSpec(Record):
 
     urdf: Annotated[str, Field(min_length=1, max_length=1000, pattern=r"^[^\x00]+$")] = "ur10"
     """A robot of example-robot-data by its short name (ur3, ur5, ur10, ur3-gripper, ur5-gripper, panda,
-    kinova, xarm7, z1, so100, so101) or the path of a URDF file, relative to the cell file: a serial chain of
-    revolute, continuous and prismatic joints (fixed and ``<mimic>`` joints too), with velocity limits."""
+    kinova, xarm7, z1, so100, so101) or the path of a URDF file, relative to the cell file: a chain or tree of
+    revolute, continuous and prismatic joints (fixed and ``<mimic>`` joints too), with velocity limits, and a
+    shape for every moving link that has a mass (docs/robot.md)."""
     base: Pose = Pose()
     """The base frame in the cell."""
     capsules: CapsulesField = "auto"
-    """The collision capsules: auto (fitted to the URDF's collision meshes) or a list."""
+    """The collision capsules: auto (one per link, enclosing its collision shapes: meshes, boxes, cylinders,
+    spheres, capsules; its visual shapes where it has none: docs/robot.md) or a list."""
     extra_capsules: tuple[CapsuleSpec, ...] = Field((), max_length=MAX_CAPSULES)
     """Capsules added to the robot's own, e.g. a gripper holding a part."""
     stopping_time: PositiveTime = 0.15
     """Time [s] from the stop signal to standstill, braking along the path."""
     pedestal: Literal["auto", "none"] = "auto"
-    """auto: the robot's base (its base link's collision mesh in plan, from the floor up to the base link's top)
+    """auto: the robot's base (the shapes of the links that do not move, in plan, from the floor up to their top)
     is an obstacle the worker cannot walk or lean into; none: nothing below the base (a robot hung from above)."""
     hold: tuple[HeldJoint, ...] = Field((), max_length=MAX_JOINTS)
     """Joints the program does not drive, each held at a value (a gripper at a set opening)."""

@@ -17,7 +17,9 @@ def check(
     Exit code 0 if the static check passes, 1 if it fails (a gate for a design in CI), 2 for a file that is not
     a valid cell."""
     from cellstress.analysis.iso13855 import check_cell
+    from cellstress.analysis.robot_audit import audit_robot
     from cellstress.cell.load import BUILTIN_CELLS, builtin_file, load_cell
+    from cellstress.robot.geometry import robot_geometry
     from cellstress.sim.build import build_layout
 
     with spinner_while_compiling(), user_errors():
@@ -25,14 +27,16 @@ def check(
         spec = c.spec
         layout = build_layout(c)
         static = check_cell(c, layout)
+        audits = [audit_robot(robot_geometry(p.model.urdf), p.capsules, p.joints) for p in layout.robots]
 
     out = say
     where = f"built-in: {builtin_file(cell)}" if cell in BUILTIN_CELLS else f"file: {c.source}"
     out(f"cell        {spec.name}  ({where}, sha256 {c.sha256[:12]})")
     if spec.description:
         out(f"            {first_sentence(spec.description)}")
-    for part in layout.robots:
+    for part, audit in zip(layout.robots, audits, strict=True):
         _robot_lines(part, c.files_dir, len(layout.robots) > 1)
+        out("robot audit " + "\n            ".join(audit.lines(part.model.joint_names)))
     obstacles = layout.obstacles
     out(f"obstacles   {len(obstacles)}" + ("" if obstacles else " (nothing on the floor)"))
     for o in obstacles:
@@ -73,7 +77,7 @@ def _robot_lines(part, files_dir, several: bool) -> None:
     out, rs, robot, caps, traj = say, part.spec, part.model, part.capsules, part.trajectory
     urdf = resolve_urdf(rs.urdf, files_dir)
     n_own = len(caps) - len(rs.extra_capsules)
-    cap_kind = "fitted to the collision meshes" if rs.capsules == "auto" else "declared"
+    cap_kind = "fitted to the links' shapes" if rs.capsules == "auto" else "declared"
     task = rs.task
     base = rs.base
     out(f"robot       {rs.name + ': ' if several else ''}{rs.urdf} -> {urdf}")

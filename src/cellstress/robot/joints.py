@@ -58,6 +58,37 @@ class JointMap:
         return np.where(revolute, np.deg2rad(values), values)
 
 
+def ancestors_or_self(robot: RobotModel, j: int) -> set[int]:
+    """Joint j and every joint between it and the base."""
+    out = set()
+    while j >= 0:
+        out.add(j)
+        j = int(robot.parents[j])
+    return out
+
+
+def branching(jmap: JointMap) -> tuple[int, int] | None:
+    """Two driven joints on separate branches of the robot's tree (neither carries the other), or None when the
+    driven joints lie on one chain. A tree robot (two arms on one torso) has such a pair."""
+    driven = jmap.driven
+    for i, a in enumerate(driven):
+        line = ancestors_or_self(jmap.robot, a)
+        for b in driven[i + 1:]:
+            if a not in ancestors_or_self(jmap.robot, b) and b not in line:
+                return a, b
+    return None
+
+
+def chains(jmap: JointMap) -> tuple[tuple[int, ...], ...]:
+    """The driven joints grouped by the highest driven joint that carries them: one group per arm of a tree
+    robot (a branching below an arm's first joint stays in its group)."""
+    groups: dict[int, list[int]] = {}
+    for j in jmap.driven:
+        top = min(ancestors_or_self(jmap.robot, j) & set(jmap.driven))
+        groups.setdefault(top, []).append(j)
+    return tuple(tuple(g) for g in groups.values())
+
+
 def joint_map(robot: RobotModel, held: dict[int, float]) -> JointMap:
     driven = tuple(j for j in range(robot.n_joints) if robot.mimic_master[j] < 0 and j not in held)
     return JointMap(robot, driven, dict(held))

@@ -1,21 +1,27 @@
 """A serial robot from a URDF, loaded with pinocchio and flattened into arrays for the compiled simulator.
 
-Pinocchio gives the kinematic tree (joint placements, axes, limits) and the collision meshes. We keep the
-chain as plain arrays so that the numba kernel can do forward kinematics without Python objects, and the tests
-check that kernel against pinocchio itself.
+Pinocchio gives the kinematic tree (joint placements, axes, limits), from the URDF text ``robot.urdf_file``
+has checked first; the links' shapes are ``robot.geometry``'s. We keep the tree as plain arrays so that the
+numba kernel can do forward kinematics without Python objects, and the tests check that kernel against
+pinocchio itself.
 """
 
 from __future__ import annotations
 
-import importlib.metadata
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from xml.etree import ElementTree
 
 import numpy as np
 
 from cellstress.core.errors import CellstressError
+from cellstress.robot.urdf_file import (
+    captured_fd2,
+    example_robot_data_share,
+    parser_reason,
+    read_urdf,
+    resolve_mesh,
+)
 
 # Short names for the fixed-base serial arms shipped by example-robot-data, resolved to files inside that
 # package.
@@ -33,25 +39,6 @@ BUILTIN_URDFS = {
     "so101": "robots/so_arm_description/urdf/so101.urdf",
 }
 BUILTIN_ROBOTS: tuple[str, ...] = tuple(BUILTIN_URDFS)
-MAX_URDF_BYTES = 20 * 1024 * 1024  # the largest URDF of example-robot-data is about 0.2 MB
-
-
-@lru_cache(maxsize=1)
-def example_robot_data_share() -> Path:
-    """The folder that holds example-robot-data's ``robots/`` tree (installed by pip as a cmeel package)."""
-    try:
-        files = importlib.metadata.files("example-robot-data") or []
-    except importlib.metadata.PackageNotFoundError as exc:
-        raise CellstressError("the package example-robot-data is not installed") from exc
-    for f in files:
-        parts = Path(str(f)).parts
-        if "robots" in parts and str(f).endswith(".urdf"):
-            located = Path(str(f.locate()))
-            root = located
-            while root.name != "robots":
-                root = root.parent
-            return root.parent
-    raise CellstressError("example-robot-data is installed but holds no robots/ folder")
 
 
 def looks_like_path(ref: str) -> bool:
@@ -151,42 +138,33 @@ def _se3(placement) -> np.ndarray:
 
 
 def load_pinocchio(urdf: Path):
-    """Pinocchio's model of the URDF (imported lazily: pinocchio is heavy)."""
+    """Pinocchio's model of the URDF, from the text ``read_urdf`` checked (imported lazily: pinocchio is heavy).
+    urdfdom's own complaints on file descriptor 2 are captured; if it still fails, its first one is the reason
+    of our one error."""
     import pinocchio as pin
 
-    return pin.buildModelFromUrdf(str(urdf))
+    doc = read_urdf(urdf)
+    with captured_fd2() as said:
+        try:
+            return pin.buildModelFromXML(doc.text)
+        except Exception as exc:  # noqa: BLE001 - pinocchio raises plain RuntimeError/ValueError
+            reason = exc
+    raise CellstressError(f"{urdf}: pinocchio cannot read it: {parser_reason(said, reason)}")
 
 
 def urdf_mimics(urdf: Path) -> dict[str, tuple[str, float, float]]:
     """{mimic joint: (master joint, multiplier, offset)} from the URDF's XML: pinocchio loads a mimic joint as
-    an independent one. The file is untrusted: its size is bounded and entity declarations are refused (they
-    are what XML expansion bombs are made of)."""
-    with urdf.open("rb") as fh:
-        data = fh.read(MAX_URDF_BYTES + 1)
-    if len(data) > MAX_URDF_BYTES:
-        raise CellstressError(f"{urdf}: the URDF is larger than {MAX_URDF_BYTES // 2**20} MB")
-    if b"<!ENTITY" in data:
-        raise CellstressError(f"{urdf}: the URDF declares XML entities; cellstress does not expand them")
-    try:
-        root = ElementTree.fromstring(data)
-    except ElementTree.ParseError as exc:
-        raise CellstressError(f"{urdf}: not well-formed XML ({exc})") from None
-    out: dict[str, tuple[str, float, float]] = {}
-    for joint in root.iter("joint"):
-        mimic = joint.find("mimic")
-        if mimic is None:
-            continue
-        name = joint.get("name", "")
-        try:
-            mult = float(mimic.get("multiplier", "1"))
-            off = float(mimic.get("offset", "0"))
-        except ValueError:
-            raise CellstressError(f"{urdf}: joint {name!r}: its <mimic> multiplier or offset is not a number") \
-                from None
-        if not (np.isfinite(mult) and np.isfinite(off)):
-            raise CellstressError(f"{urdf}: joint {name!r}: its <mimic> multiplier or offset is not finite")
-        out[name] = (mimic.get("joint", ""), mult, off)
-    return out
+    an independent one."""
+    return dict(read_urdf(urdf).mimics)
+
+
+def mesh_paths(urdf: Path) -> tuple[Path, ...]:
+    """Every mesh file the URDF names (collision and visual, each once, in order), resolved by ``resolve_mesh``;
+    nothing is opened."""
+    out: dict[Path, None] = {}
+    for spec in read_urdf(urdf).mesh_references():
+        out.setdefault(resolve_mesh(spec.filename, urdf), None)
+    return tuple(out)
 
 
 def _joint_kind_axis(urdf: Path, name: str, joint) -> tuple[str, tuple[float, float, float]]:
@@ -239,9 +217,11 @@ def load_robot(urdf: Path) -> RobotModel:
     for name, v, lo, hi, cont in zip(names, vmax, lower, upper, continuous, strict=True):
         if not (np.isfinite(v) and v > 0.0):
             raise CellstressError(f"{urdf}: joint {name!r} has no velocity limit (<limit velocity=...> > 0)")
-        if not cont and not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
+        if not cont and not (np.isfinite(lo) and np.isfinite(hi)):
             raise CellstressError(f"{urdf}: joint {name!r} has no finite position limits (<limit lower=... "
                                   "upper=...>)")
+        if not cont and lo > hi:
+            raise CellstressError(f"{urdf}: joint {name!r}: its lower limit {lo:g} is above its upper limit {hi:g}")
     master, mult, off = _mimic_arrays(urdf, names)
     link_joint: dict[str, int] = {}
     link_in_joint: dict[str, np.ndarray] = {}
@@ -266,29 +246,3 @@ def load_robot(urdf: Path) -> RobotModel:
         link_joint=link_joint,
         link_in_joint=link_in_joint,
     )
-
-
-def collision_vertices(urdf: Path) -> dict[str, np.ndarray]:
-    """Collision-mesh vertices of each link, in that link's joint frame (via pinocchio's geometry loader)."""
-    import pinocchio as pin
-
-    model = load_pinocchio(urdf)
-    package_dirs = [str(urdf.parent)]
-    try:
-        share = example_robot_data_share()
-        package_dirs += [str(share), str(share.parent)]  # package://example-robot-data/... resolves from share/
-    except CellstressError:
-        pass
-    geom = pin.buildGeomFromUrdf(model, str(urdf), pin.GeometryType.COLLISION, package_dirs=package_dirs)
-    out: dict[str, list[np.ndarray]] = {}
-    for obj in geom.geometryObjects:
-        if not hasattr(obj.geometry, "vertices"):
-            continue
-        verts = np.asarray(obj.geometry.vertices(), dtype=float)
-        if verts.size == 0:
-            continue
-        link = model.frames[obj.parentFrame].name
-        placement = _se3(obj.placement)  # in the parent joint frame
-        pts = verts @ placement[:3, :3].T + placement[:3, 3]
-        out.setdefault(link, []).append(pts)
-    return {k: np.concatenate(v) for k, v in out.items()}
