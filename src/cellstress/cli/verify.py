@@ -27,6 +27,9 @@ def verify(
     phases: Annotated[str, typer.Option("--phases", help="all: every arrival phase of the robot's cycle on the "
                                         "time-step grid; cell: only the phases the cell's "
                                         "human.arrival allows.")] = "all",
+    moments: Annotated[str, typer.Option("--moments", help="all: each grid phase also stands for every arrival "
+                                         "moment within half a time step of it, where the cell allows the argument "
+                                         "(docs/verify.md); grid: the grid moments alone (faster).")] = "all",
     time_limit: Annotated[float | None, typer.Option("--time-limit", help="Seconds; what is not decided by "
                                                      "then is reported as undecided (exit code 3).")] = None,
     workers: Annotated[int | None, typer.Option("--workers", help="Processes deciding sub-trees in parallel "
@@ -65,7 +68,7 @@ def verify(
     try:
         with bar, user_errors():
             sim = Simulator(with_criterion(load_cell(cell), criterion))
-            res = verify_cell(sim, horizon=horizon, phases=phases, time_limit=time_limit,
+            res = verify_cell(sim, horizon=horizon, phases=phases, moments=moments, time_limit=time_limit,
                               workers=os.cpu_count() or 1 if workers is None else workers, out=out_dir,
                               progress=tick)
     except KeyboardInterrupt:
