@@ -15,6 +15,7 @@ from typing import Any
 from pydantic import ValidationError
 
 from cellstress.cell.load import Cell
+from cellstress.core.cpus import check_workers
 from cellstress.core.errors import CellstressError
 from cellstress.core.version import __version__
 from cellstress.human.actions import N_ACTIONS
@@ -145,7 +146,8 @@ def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out:
         if progress is not None:
             progress(done[0], total)
 
-    if workers <= 1 or len(tasks) == 1:
+    workers = min(workers, len(tasks))  # never a process without a sub-tree to decide
+    if workers <= 1:
         decided = [decide_task(t, tick) for t in tasks]
     else:
         # spawned, not forked: numba's thread pool in this process makes a fork unsafe
@@ -222,8 +224,10 @@ def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "al
     except ValidationError as exc:
         e = exc.errors(include_url=False)[0]
         raise VerifyError(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}") from None
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise VerifyError(f"workers must be a whole number >= 1, not {workers!r}")
+    try:
+        check_workers(workers, "workers")
+    except CellstressError as exc:
+        raise VerifyError(str(exc)) from None
     if sim.layout.worker.articulated:
         # its bounds are the paper worker's (30 actions, reach volumes on rigid shoulders: docs/verify.md)
         raise VerifyError(f"verify proves cells with the paper's worker only; this cell's is "
