@@ -97,19 +97,26 @@ def _umask() -> int:
     return mask
 
 
-def read_input_bytes(path: str | Path, max_bytes: int = MAX_INPUT_BYTES) -> bytes:
+def read_input_bytes(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, follow: bool = True) -> bytes:
     """The bytes of a regular file of at most ``max_bytes``; InputFileError (a short reason) otherwise.
 
     The file is opened without blocking and checked with fstat before anything is read, so a FIFO or a
-    device never blocks and nothing beyond the cap is ever read."""
+    device never blocks and nothing beyond the cap is ever read. ``follow=False``: a symbolic link at ``path``
+    itself is refused (for files cellstress wrote into an output folder, where a link can only be planted)."""
     p = Path(path).expanduser()
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
+    if not follow:
+        flags |= getattr(os, "O_NOFOLLOW", 0)
     try:
-        fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))
+        fd = os.open(p, flags)
     except FileNotFoundError:
         raise InputFileError("no such file") from None
     except IsADirectoryError:
         raise InputFileError("is a directory, not a file") from None
     except OSError as exc:
+        if not follow and os.path.islink(p):
+            raise InputFileError("is a symbolic link (cellstress does not follow links in its output folders)") \
+                from None
         raise InputFileError(f"cannot be read: {exc.strerror or exc}") from None
     try:
         st = os.fstat(fd)
@@ -133,3 +140,30 @@ def read_input_bytes(path: str | Path, max_bytes: int = MAX_INPUT_BYTES) -> byte
         raise InputFileError(f"cannot be read: {exc.strerror or exc}") from None
     finally:
         os.close(fd)
+
+
+class _Duplicate(Exception):
+    def __init__(self, key: str):
+        self.key = key
+
+
+def _no_repeats(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    seen: dict[str, Any] = {}
+    for k, v in pairs:
+        if k in seen:
+            raise _Duplicate(k)
+        seen[k] = v
+    return seen
+
+
+def duplicate_json_key(raw: bytes | str) -> str | None:
+    """The first key that a JSON object of ``raw`` repeats, or None (also for text that is not JSON: its
+    parser says what is wrong). A repeated key is refused in every JSON file cellstress reads: parsers keep
+    one of the two values, and which one differs between programs, so two readers could see two files."""
+    try:
+        json.loads(raw, object_pairs_hook=_no_repeats)
+    except _Duplicate as dup:
+        return dup.key
+    except (ValueError, RecursionError, UnicodeDecodeError):
+        return None
+    return None

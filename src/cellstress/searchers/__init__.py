@@ -13,6 +13,7 @@ from pathlib import Path
 
 from cellstress.core import registry
 from cellstress.core.errors import PluginError
+from cellstress.core.io import duplicate_json_key
 from cellstress.core.version import __version__
 from cellstress.searchers.common import (
     UNTIL,
@@ -74,8 +75,11 @@ def parse_options(settings: list[str] | tuple[str, ...] | None, flag: str = "--s
             raise SearchError(f"{flag}: option {name!r} given twice")
         try:
             out[name] = json.loads(text)
-        except ValueError:
+        except (ValueError, RecursionError):
             out[name] = text.strip()
+        dup = duplicate_json_key(text)
+        if dup is not None:
+            raise SearchError(f"{flag} {name}: the key {dup[:60]!r} appears twice in the value")
     return out
 
 
