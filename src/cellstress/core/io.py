@@ -11,10 +11,12 @@ from __future__ import annotations
 import json
 import math
 import os
+import secrets
 import stat
-import tempfile
 from pathlib import Path
 from typing import Any
+
+from cellstress.core.errors import CellstressError
 
 MAX_INPUT_BYTES = 10 * 1024 * 1024  # no cell or result file of ours comes near this (a result is ~1 MB)
 
@@ -61,33 +63,98 @@ def atomic_write(path: Path, data: bytes) -> None:
 
     The new file gets the permissions a plain ``open`` would give it (0666 less the umask)."""
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}-", suffix=".tmp", dir=path.parent)
+    fd = os.open(path.parent if str(path.parent) else ".", os.O_RDONLY | _DIRECTORY)
     try:
-        os.fchmod(fd, 0o666 & ~_umask())
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
+        _atomic_write_at(fd, path.name, data)
+    finally:
+        os.close(fd)
 
 
 def atomic_write_text(path: Path, text: str) -> None:
     atomic_write(path, text.encode("utf-8"))
 
 
-def write_in_folder(folder: str | Path, name: str, text: str) -> Path:
-    """Write ``folder/name`` atomically (the folder made if missing); returns its path."""
+class OutputPathError(CellstressError):
+    """A folder cellstress would write into is a symbolic link (or a file) planted inside an output folder."""
+
+
+_DIRECTORY = getattr(os, "O_DIRECTORY", 0)
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
+
+
+def _atomic_write_at(dir_fd: int, name: str, data: bytes) -> None:
+    """Write ``name`` in the folder open as ``dir_fd``: a new file of a random name, then renamed over ``name``
+    (a link planted at ``name`` is replaced, not followed; nothing is looked up by path outside the folder)."""
+    for _ in range(100):
+        tmp = f".{name}-{secrets.token_hex(6)}.tmp"
+        try:  # the mode is masked by the umask, as for a plain open
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | _NOFOLLOW, 0o666, dir_fd=dir_fd)
+            break
+        except FileExistsError:
+            continue
+    else:
+        raise FileExistsError(f"no free temporary name for {name}")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, name, src_dir_fd=dir_fd, dst_dir_fd=dir_fd)
+    except BaseException:
+        try:
+            os.unlink(tmp, dir_fd=dir_fd)
+        except FileNotFoundError:
+            pass
+        raise
+
+
+def _open_below(root: Path, parts: tuple[str, ...]) -> int:
+    """A descriptor of the folder ``root/parts...``, each part made if missing and opened without following a
+    link, so nothing planted below ``root`` can send a write elsewhere; ``root`` itself is followed (the user
+    named it)."""
+    fd = os.open(root, os.O_RDONLY | _DIRECTORY)
+    where = root
+    try:
+        for part in parts:
+            where = where / part
+            if part in ("", ".", "..") or "/" in part:
+                raise OutputPathError(f"{where}: not a plain folder name")
+            try:
+                os.mkdir(part, 0o777, dir_fd=fd)
+            except FileExistsError:
+                pass
+            try:
+                sub = os.open(part, os.O_RDONLY | _DIRECTORY | _NOFOLLOW, dir_fd=fd)
+            except OSError:
+                kind = "a symbolic link" if os.path.islink(where) else "not a folder"
+                raise OutputPathError(f"{where}: is {kind}; cellstress never writes through a link or over a file "
+                                      f"inside its output folder {root} (remove it, or use another folder)") from None
+            os.close(fd)
+            fd = sub
+    except BaseException:
+        os.close(fd)
+        raise
+    return fd
+
+
+def write_in_folder(folder: str | Path, name: str, text: str, *, inside: str | Path | None = None) -> Path:
+    """Write ``folder/name`` atomically (the folder made if missing); returns its path.
+
+    ``inside``: an output folder the user chose, which ``folder`` lies in: the folders between are made or
+    opened without following a symbolic link (OutputPathError for a link or a file planted there)."""
     out = Path(folder)
-    out.mkdir(parents=True, exist_ok=True)
-    path = out / name
-    atomic_write_text(path, text)
-    return path
+    if inside is None:
+        out.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(out / name, text)
+        return out / name
+    root = Path(inside)
+    root.mkdir(parents=True, exist_ok=True)
+    fd = _open_below(root, out.relative_to(root).parts)
+    try:
+        _atomic_write_at(fd, name, text.encode("utf-8"))
+    finally:
+        os.close(fd)
+    return out / name
 
 
 def _umask() -> int:

@@ -236,9 +236,10 @@ class SearchResult(Record):
     def to_json(self) -> str:
         return canonical_json(self.to_dict())
 
-    def write(self, out_dir: str | Path) -> Path:
-        """Write ``out_dir/result.json`` atomically; returns its path."""
-        return write_in_folder(out_dir, FILE_NAME, self.to_json())
+    def write(self, out_dir: str | Path, *, inside: str | Path | None = None) -> Path:
+        """Write ``out_dir/result.json`` atomically; returns its path. ``inside``: the output folder the user
+        chose, when ``out_dir`` is a folder of ours within it (``core.io.write_in_folder``)."""
+        return write_in_folder(out_dir, FILE_NAME, self.to_json(), inside=inside)
 
     @classmethod
     def load(cls, path: str | Path) -> SearchResult:

@@ -5,6 +5,7 @@ does not depend on the number of workers or on which finished first."""
 from __future__ import annotations
 
 import multiprocessing
+import re
 import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
@@ -17,6 +18,7 @@ from pydantic import ValidationError
 from cellstress.cell.load import Cell
 from cellstress.core.cpus import check_workers
 from cellstress.core.errors import CellstressError
+from cellstress.core.io import OutputPathError
 from cellstress.core.version import __version__
 from cellstress.human.actions import N_ACTIONS
 from cellstress.searchers.distinct import hazard_class, hazard_class_record, root_cause
@@ -182,7 +184,7 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
         rel = f"{WITNESS_DIR.format(c['index'] + 1)}/result.json"
         actions = witness_actions(cell, task.start, task.phase, f.actions)
         if out is not None:
-            write_witness(sim, actions, Path(out) / WITNESS_DIR.format(c["index"] + 1))
+            write_witness(sim, actions, Path(out), WITNESS_DIR.format(c["index"] + 1))
         klass = hazard_class_record(f.key)
         witnesses.append(Witness.model_construct(
             klass=klass, root_cause=root_cause(klass), start=task.start.name, phase=task.phase,
@@ -210,6 +212,18 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
 
 
 
+def check_witness_folders(out: Path) -> None:
+    """Refuse, before any work, an output folder whose witness folders are links or files (planted there: a
+    witness is never written through one, ``core.io.write_in_folder``); OutputPathError naming it."""
+    if not out.is_dir():
+        return
+    for entry in sorted(out.iterdir()):
+        if re.fullmatch(r"witness-\d+", entry.name) and (entry.is_symlink() or not entry.is_dir()):
+            kind = "a symbolic link" if entry.is_symlink() else "not a folder"
+            raise OutputPathError(f"{entry}: is {kind}; cellstress never writes through a link or over a file "
+                                  f"inside its output folder {out} (remove it, or use another folder)")
+
+
 def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "all", time_limit: float | None = None,
                 bounds: tuple[str, ...] | None = None, workers: int = 1, out: str | Path | None = None,
                 progress: Callable[[int, int], None] | None = None) -> VerifyResult:
@@ -228,6 +242,8 @@ def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "al
         check_workers(workers, "workers")
     except CellstressError as exc:
         raise VerifyError(str(exc)) from None
+    if out is not None:
+        check_witness_folders(Path(out))
     if sim.layout.worker.articulated:
         # its bounds are the paper worker's (30 actions, reach volumes on rigid shoulders: docs/verify.md)
         raise VerifyError(f"verify proves cells with the paper's worker only; this cell's is "
