@@ -15,6 +15,7 @@ from pathlib import Path
 import yaml
 from pydantic import BaseModel, ValidationError
 
+from cellstress.cell.files import cell_files, refuse_files_outside
 from cellstress.cell.program import robot_program
 from cellstress.cell.schema import CRITERIA, DEVICE_KINDS, CellSpec
 from cellstress.core import registry
@@ -22,6 +23,7 @@ from cellstress.core.errors import CellError, CellstressError
 from cellstress.core.io import MAX_INPUT_BYTES, InputFileError, read_input_bytes
 from cellstress.core.plane import point_segment_distance, polygon_distance
 from cellstress.core.protocols import Channels
+from cellstress.core.provenance import InputFile
 from cellstress.core.records import Channel
 from cellstress.devices.base import stops_of
 from cellstress.human.body import BODY_RADIUS, WALK_BLOCK_HEIGHT
@@ -43,6 +45,7 @@ class Cell:
     source: str  # the built-in name or the path as given
     directory: Path | None  # folder for relative paths in the file (None for built-ins)
     sha256: str
+    files: tuple[InputFile, ...] = ()  # every file the cell reads, with its size and SHA-256 (cell.files)
 
     @property
     def name(self) -> str:
@@ -315,7 +318,7 @@ def parse_cell(text: str, source: str, directory: Path | None) -> Cell:
         raise CellError(source, field, msg + more) from None
     cell = Cell(spec, source, directory, hashlib.sha256(text.encode()).hexdigest())
     check_geometry(cell)
-    return cell
+    return replace(cell, files=cell_files(cell, text))
 
 
 def load_cell(name_or_path: str | Path) -> Cell:
@@ -347,6 +350,7 @@ def check_geometry(cell: Cell) -> None:
     position and velocity limits, the robot's cycle time, the robots' names and the devices' ``stops``, the start
     pose and every named start point."""
     spec = cell.spec
+    refuse_files_outside(cell)
     several = "robots" in spec.model_fields_set  # a robots list, even of one: its errors name robots[i]
     cycles = [_check_robot(cell, rs, f"robots[{i}]" if several else "robot") for i, rs in enumerate(spec.robots)]
     _check_robot_names(cell)

@@ -8,6 +8,7 @@ Inputs (cell files, result files) are untrusted: only regular files are read, an
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import os
@@ -234,3 +235,34 @@ def duplicate_json_key(raw: bytes | str) -> str | None:
     except (ValueError, RecursionError, UnicodeDecodeError):
         return None
     return None
+
+
+MAX_HASHED_BYTES = 2**30  # a file a cell pulls in (a mesh, a trajectory): far above what its reader accepts
+
+
+def file_digest(path: str | Path, max_bytes: int = MAX_HASHED_BYTES) -> tuple[int, str]:
+    """(size in bytes, SHA-256) of a regular file, read in pieces (never whole into memory); InputFileError for
+    anything else, before a byte is read, as ``read_input_bytes``."""
+    try:
+        fd = os.open(Path(path), os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))
+    except FileNotFoundError:
+        raise InputFileError("no such file") from None
+    except OSError as exc:
+        raise InputFileError(f"cannot be read: {exc.strerror or exc}") from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise InputFileError("is not a regular file (a pipe, a device, a socket or a folder)")
+        if st.st_size > max_bytes:
+            raise InputFileError(f"is too large ({st.st_size:,} bytes; at most {max_bytes:,})")
+        h, total = hashlib.sha256(), 0
+        while chunk := os.read(fd, 1 << 20):
+            total += len(chunk)
+            if total > max_bytes:
+                raise InputFileError(f"is too large (more than {max_bytes:,} bytes)")
+            h.update(chunk)
+        return total, h.hexdigest()
+    except OSError as exc:
+        raise InputFileError(f"cannot be read: {exc.strerror or exc}") from None
+    finally:
+        os.close(fd)

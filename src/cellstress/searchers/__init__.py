@@ -163,7 +163,7 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
     source = c.source if c.directory is None else str(Path(c.source).expanduser().resolve())
     crit = c.spec.criterion.type
     return SearchResult.model_construct(
-        cell=CellRef.model_construct(name=c.name, sha256=c.sha256, source=source, criterion=crit),
+        cell=CellRef.model_construct(name=c.name, sha256=c.sha256, source=source, criterion=crit, files=c.files),
         searcher=s.name,
         params=asdict(s),
         seed=int(seed),

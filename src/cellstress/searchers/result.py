@@ -27,6 +27,7 @@ from cellstress.core.io import (
     read_input_bytes,
     write_in_folder,
 )
+from cellstress.core.provenance import InputFiles
 from cellstress.searchers.common import UNTIL, SearchError
 from cellstress.sim.records import Name, StepRecord
 
@@ -47,13 +48,22 @@ VERDICT = TypeAdapter(dict[Name, bool | int | float | Annotated[str, Field(max_l
 
 class CellRef(Record):
     """The cell searched: its name, the sha256 of its file's text, where it came from (a built-in name or an
-    absolute path), and the criterion it was judged by (absent from early files: the default,
-    contact-while-moving)."""
+    absolute path), the criterion it was judged by (absent from early files: the default,
+    contact-while-moving) and every file it read, with size and sha256 (``cell.files``; absent from files
+    written before issue 29)."""
 
     name: Name
     sha256: Annotated[str, Field(pattern=r"^[0-9a-f]{64}$")]
     source: Annotated[str, Field(max_length=4096)]
     criterion: Name | None = None
+    files: InputFiles | None = None
+
+    @model_serializer(mode="wrap")
+    def _drop_absent(self, handler):
+        out = handler(self)
+        if out.get("files") is None:
+            out.pop("files", None)
+        return out
 
 
 class HazardClass(Record):

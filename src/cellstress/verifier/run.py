@@ -199,7 +199,8 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
             acc[1] += p.sequences
     source = cell.source if cell.directory is None else str(Path(cell.source).expanduser().resolve())
     result = VerifyResult(
-        cell=CellRef(name=cell.name, sha256=cell.sha256, source=source, criterion=cell.spec.criterion.type),
+        cell=CellRef(name=cell.name, sha256=cell.sha256, source=source, criterion=cell.spec.criterion.type,
+                     files=cell.files),
         options=options, dt=sim.dt, cycle=float(sim.layout.trajectory.cycle), merge_xy=QUANT_XY,
         merge_angle=QUANT_ANGLE, verdict=UNSAFE if hazardous else UNDECIDED if undecided else PROVED_SAFE,
         sequences=sum(s.sequences for s in subtrees), hazardous=hazardous, undecided=undecided,

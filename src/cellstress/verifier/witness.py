@@ -44,7 +44,8 @@ def witness_result(sim, actions: list[str], source: str) -> SearchResult:
             break
     acts = tuple(actions)
     return SearchResult.model_construct(
-        cell=CellRef.model_construct(name=c.name, sha256=c.sha256, source=source, criterion=c.spec.criterion.type),
+        cell=CellRef.model_construct(name=c.name, sha256=c.sha256, source=source, criterion=c.spec.criterion.type,
+                                     files=c.files),
         searcher=SEARCHER, params={}, seed=0, budget=1, until="first", found=True, episodes=1,
         hazard=hazard_record(sim, 1, list(acts)),
         hazards=(EpisodeRef.model_construct(episode=1, actions=acts),),
