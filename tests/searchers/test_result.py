@@ -57,3 +57,34 @@ def test_a_key_given_twice_is_refused(tmp_path, doc, key):
     with pytest.raises(SearchError) as err:
         _load(tmp_path, text=text)
     assert f"the key '{key}' appears twice in one object" in str(err.value)
+
+
+def test_the_files_the_cell_read_are_recorded(doc):
+    files = doc["cell"]["files"]
+    assert files[0] == {"use": "cell", "path": "cellstress:cell/builtin/s1-scanner-width.yaml",
+                        "bytes": files[0]["bytes"], "sha256": doc["cell"]["sha256"]}
+    assert [f["use"] for f in files[1:3]] == ["robot.urdf", "robot.urdf mesh"]
+
+
+@pytest.mark.parametrize(("change", "says"), [
+    (lambda fs: fs.extend([fs[0]] * 10_001), "cell.files: Tuple should have at most 10000 items"),
+    (lambda fs: fs[1].update(sha256="z" * 64), "cell.files[1].sha256: String should match pattern"),
+    (lambda fs: fs[1].update(path="a\x1b[2Jb"), "cell.files[1].path: String should match pattern"),
+    (lambda fs: fs[1].update(bytes=-1), "cell.files[1].bytes: Input should be greater than or equal to 0"),
+    (lambda fs: fs[1].update(bytes="12"), "cell.files[1].bytes: Input should be a valid integer"),
+    (lambda fs: fs[1].update(evil=1), "cell.files[1].evil: Extra inputs are not permitted"),
+])
+def test_recorded_files_are_checked(tmp_path, doc, change, says):
+    d = json.loads(json.dumps(doc))
+    change(d["cell"]["files"])
+    with pytest.raises(SearchError) as err:
+        _load(tmp_path, d)
+    assert f"not a cellstress result file: {says}" in str(err.value), err.value
+
+
+def test_a_file_without_the_list_still_loads(tmp_path, doc):
+    """Files written before issue 29 make no claim about the files: they load, and the list stays absent."""
+    d = json.loads(json.dumps(doc))
+    del d["cell"]["files"]
+    res = _load(tmp_path, d)
+    assert res.cell.files is None and "files" not in json.loads(res.to_json())["cell"]

@@ -76,8 +76,10 @@ def confined() -> bool:
 
 def _refuse_outside(cell, read: Read) -> None:
     if read.outside and confined():
-        where = "no folder (a built-in cell)" if cell.directory is None else f"its folder {cell.directory}"
-        raise CellError(cell.source, read.use, f"reads {os.path.realpath(read.path)}, outside {where}; with "
+        where = "no folder (a built-in cell)" if cell.directory is None else f"the cell's folder {cell.directory}"
+        field, what = (read.use[: -len(" mesh")], "names the mesh") if read.use.endswith(" mesh") else \
+            (read.use, "is")
+        raise CellError(cell.source, field, f"{what} {os.path.realpath(read.path)}, outside {where}; with "
                         f"{CONFINE_VAR}={INSIDE} a cell reads only files in its folder and the robots shipped with "
                         "cellstress and example-robot-data")
 
