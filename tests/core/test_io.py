@@ -98,3 +98,22 @@ def test_reading_without_following(tmp_path, victim):
 ])
 def test_duplicate_json_key(text, key):
     assert duplicate_json_key(text) == key
+
+
+def test_file_digest_streams_regular_files_only(tmp_path):
+    import hashlib
+
+    from cellstress.core.io import file_digest
+
+    data = bytes(range(256)) * 5000
+    (tmp_path / "a.bin").write_bytes(data)
+    assert file_digest(tmp_path / "a.bin") == (len(data), hashlib.sha256(data).hexdigest())
+    with pytest.raises(InputFileError, match="too large"):
+        file_digest(tmp_path / "a.bin", max_bytes=1000)
+    os.mkfifo(tmp_path / "fifo")
+    with pytest.raises(InputFileError, match="not a regular file"):
+        file_digest(tmp_path / "fifo")
+    with pytest.raises(InputFileError, match="not a regular file"):
+        file_digest(tmp_path)
+    with pytest.raises(InputFileError, match="no such file"):
+        file_digest(tmp_path / "none")
