@@ -154,6 +154,8 @@ def test_replay_names_the_file_that_changed(tmp_path, capsys):
                           "changed (sha256 cf3da51c9417 recorded, "
                           f"{hashlib.sha256((folder / 'palletizing.csv').read_bytes()).hexdigest()[:12]} now; "
                           "52,822 bytes recorded, 52,823 now)"]
+    assert main(["report", str(out / "result.json")]) == 0  # the report says so too
+    assert "the cell file, or a file it reads, has changed since the search" in capsys.readouterr().out
 
 
 def test_shown_path_resolves_links(tmp_path):
