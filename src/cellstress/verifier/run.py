@@ -5,6 +5,7 @@ does not depend on the number of workers or on which finished first."""
 from __future__ import annotations
 
 import multiprocessing
+import re
 import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
@@ -15,7 +16,9 @@ from typing import Any
 from pydantic import ValidationError
 
 from cellstress.cell.load import Cell
+from cellstress.core.cpus import check_workers
 from cellstress.core.errors import CellstressError
+from cellstress.core.io import OutputPathError
 from cellstress.core.version import __version__
 from cellstress.human.actions import N_ACTIONS
 from cellstress.searchers.distinct import hazard_class, hazard_class_record, root_cause
@@ -209,7 +212,8 @@ def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out:
         if progress is not None:
             progress(done[0], total)
 
-    if workers <= 1 or len(tasks) == 1:
+    workers = min(workers, len(tasks))  # never a process without a sub-tree to decide
+    if workers <= 1:
         decided = [decide_task(t, tick) for t in tasks]
     else:
         # spawned, not forked: numba's thread pool in this process makes a fork unsafe
@@ -244,7 +248,7 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
         rel = f"{WITNESS_DIR.format(c['index'] + 1)}/result.json"
         actions = witness_actions(cell, task.start, f.phase, f.actions)
         if out is not None:
-            write_witness(sim, actions, Path(out) / WITNESS_DIR.format(c["index"] + 1))
+            write_witness(sim, actions, Path(out), WITNESS_DIR.format(c["index"] + 1))
         klass = hazard_class_record(f.key)
         witnesses.append(Witness.model_construct(
             klass=klass, root_cause=root_cause(klass), start=task.start.name, phase=f.phase,
@@ -265,7 +269,8 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
             acc[1] += p.sequences
     source = cell.source if cell.directory is None else str(Path(cell.source).expanduser().resolve())
     result = VerifyResult(
-        cell=CellRef(name=cell.name, sha256=cell.sha256, source=source, criterion=cell.spec.criterion.type),
+        cell=CellRef(name=cell.name, sha256=cell.sha256, source=source, criterion=cell.spec.criterion.type,
+                     files=cell.files),
         options=options, dt=sim.dt, cycle=float(sim.layout.trajectory.cycle), scope=scope,
         verdict=UNSAFE if unsafe else UNDECIDED if undecided or alarms else PROVED_SAFE,
         sequences=sum(s.sequences for s in subtrees), hazardous=hazardous, undecided=undecided, alarms=alarms,
@@ -276,6 +281,18 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
         result.write(out)
     return result
 
+
+
+def check_witness_folders(out: Path) -> None:
+    """Refuse, before any work, an output folder whose witness folders are links or files (planted there: a
+    witness is never written through one, ``core.io.write_in_folder``); OutputPathError naming it."""
+    if not out.is_dir():
+        return
+    for entry in sorted(out.iterdir()):
+        if re.fullmatch(r"witness-\d+", entry.name) and (entry.is_symlink() or not entry.is_dir()):
+            kind = "a symbolic link" if entry.is_symlink() else "not a folder"
+            raise OutputPathError(f"{entry}: is {kind}; cellstress never writes through a link or over a file "
+                                  f"inside its output folder {out} (remove it, or use another folder)")
 
 
 def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "all", moments: str = "all",
@@ -293,8 +310,12 @@ def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "al
     except ValidationError as exc:
         e = exc.errors(include_url=False)[0]
         raise VerifyError(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}") from None
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise VerifyError(f"workers must be a whole number >= 1, not {workers!r}")
+    try:
+        check_workers(workers, "workers")
+    except CellstressError as exc:
+        raise VerifyError(str(exc)) from None
+    if out is not None:
+        check_witness_folders(Path(out))
     if sim.layout.worker.articulated:
         # its bounds are the paper worker's (30 actions, reach volumes on rigid shoulders: docs/verify.md)
         raise VerifyError(f"verify proves cells with the paper's worker only; this cell's is "
