@@ -1,0 +1,386 @@
+"""The robot program check of ``cellstress check``: per move of each robot's program its largest joint travel,
+the tool's top speed and the cycle time, and two failures an integrator would never program.
+
+* **The long way round.** A move that turns a revolute joint by more than 180 deg when the joint's range lets
+  it reach the same angle the other way (the target +- 360 deg within its limits) fails: the robot would sweep
+  more than half a revolution for nothing (docs/robots.md). A joint whose range leaves no other way (a Panda
+  joint of +-166 deg) may turn further: that is the only way there, not a mistake. Joints that follow a
+  ``<mimic>`` master are left to it.
+* **Through a solid.** A moving link passes through the robot's own pedestal, the table, an obstacle, a fence
+  or the floor when its collision capsule's axis (the core line inside the link's geometry; the capsule's
+  radius only encloses it) goes more than ``DEPTH`` into the solid (below the floor, within ``DEPTH`` of a
+  fence panel, which has no thickness). A link merely touching a surface (a gripper set down on the table, the
+  first link turning on its base) is not: its axis stays outside or at the surface. The robot's fixed links
+  (its base) stand on the pedestal and are not tested.
+
+Sampling, and why it cannot miss a pass: the capsules are posed every ``dt`` of path time by the simulator's own
+kernels (as ``sim.scene.robot_capsules`` poses them), with ``dt = DEPTH / v_bound``, where ``v_bound`` bounds
+the speed of every point of every capsule axis over the whole program (``point_speed_bound``: each joint's peak
+speed on its move times its largest lever arm to the point, summed along the chain; an axis point is a convex
+combination of the axis's ends, so no point is faster than the faster end). Along each axis the depth is read
+at points at most ``DEPTH`` apart. Depth inside a solid is 1-Lipschitz in the point, so an axis point that at
+any instant lies ``2 DEPTH`` deep is, at the nearest sample (``dt / 2`` away, ``DEPTH / 2`` of travel) and at the
+nearest point along the axis (``DEPTH / 2`` away), still more than ``DEPTH`` deep, and is reported; nothing
+shallower than ``DEPTH`` is. For a fence panel the same bound puts an axis that crosses it within
+``DEPTH / 2`` of it at the nearest sample. A solid thinner than ``4 DEPTH`` (4 cm) could let a pass through it
+go unreported; fences are tested as panels for that reason.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from cellstress.analysis.plane import distance_to_polyline, points_in_polygon
+from cellstress.robot.model import REVOLUTE, RobotModel, load_pinocchio
+from cellstress.robot.trajectory import Trajectory, evaluate
+from cellstress.robot.turns import EPS, least_largest_move, turns_freely
+from cellstress.sim import kernels as K
+from cellstress.sim import layout as L
+from cellstress.sim.build import Layout, RobotPart
+from cellstress.sim.geometry import segment_rectangle_xyz
+
+DEPTH = 0.01  # m: a capsule axis this far inside a solid (or this near a fence panel) passes through it
+SPEED_DT = 0.005  # s of path time between the tool speed's samples along a move
+MIN_SPEED_SAMPLES = 64  # per move (3 per row of a trajectory file's short linear moves)
+CHUNK = 2048  # capsule samples posed and measured at once
+MAX_LISTED = 12  # failure lines listed per robot; the rest are counted
+HALF_TURN = math.pi
+
+
+@dataclass(frozen=True)
+class MoveCheck:
+    """One move of a program: from waypoint ``index`` to the next (the last one back to the first)."""
+
+    index: int  # 0-based
+    start: float  # path time [s] the move begins (after its waypoint's dwell)
+    duration: float  # s
+    joint: str  # the revolute joint turning most ('' if none turns)
+    turn_deg: float  # its travel [deg]
+    slide_joint: str  # the prismatic joint sliding most ('' if none slides)
+    slide_m: float  # its travel [m]
+    tool_speed: float  # m/s, the tool frame's top speed along the move
+    long_way: tuple[tuple[str, float, float], ...]  # (joint, travel deg, least largest travel deg): each a FAIL
+
+
+@dataclass(frozen=True)
+class PassThrough:
+    """A link's capsule axis inside a solid during a move: the deepest sample of that (move, link, solid)."""
+
+    move: int
+    link: str
+    solid: str  # 'the floor', 'robot-pedestal', 'table', an obstacle's name, 'fence F panel P'
+    depth: float  # m (a fence panel: DEPTH minus the axis's distance from it)
+    t: float  # path time [s] of the deepest sample, in [0, cycle)
+
+
+@dataclass(frozen=True)
+class ProgramCheck:
+    """The program check of one robot."""
+
+    robot: str  # '' in a cell of one robot
+    tool: str  # the frame whose speed is reported
+    kind: str  # 'pose', 'waypoint' or 'row' (a trajectory file's rows)
+    cycle: float  # s
+    moves: tuple[MoveCheck, ...]
+    passes: tuple[PassThrough, ...]
+    speed_bound: float  # m/s, the largest bound on capsule axis point speed (samples are DEPTH / bound apart)
+
+    @property
+    def ok(self) -> bool:
+        return not self.passes and not any(m.long_way for m in self.moves)
+
+    def failures(self) -> list[str]:
+        """'program' (or 'program:ROBOT') when this robot's program fails, as ``StaticCheck.failures``."""
+        return [] if self.ok else ["program" + (f":{self.robot}" if self.robot else "")]
+
+    def lines(self) -> list[str]:
+        return program_lines(self)
+
+
+# ---- joint travel ------------------------------------------------------------------------------------------
+def long_way_round(robot: RobotModel, waypoints: np.ndarray) -> list[tuple[int, str, float, float]]:
+    """(move, joint, its travel there [deg], the least largest travel of that joint [deg]) for each joint that
+    turns more than half a turn on some move when whole turns of the waypoints, within its limits, would keep
+    its largest move shorter (``robot.turns.least_largest_move``); the move named is the joint's longest."""
+    out: list[tuple[int, str, float, float]] = []
+    moves = np.roll(waypoints, -1, axis=0) - waypoints
+    for j in range(robot.n_joints):
+        if not turns_freely(robot, j):
+            continue
+        travel = np.abs(moves[:, j])
+        i = int(np.argmax(travel))
+        if travel[i] <= HALF_TURN + EPS:
+            continue
+        least = least_largest_move(waypoints[:, j], float(robot.lower[j]), float(robot.upper[j]))
+        if travel[i] > least + 1e-6:
+            out.append((i, robot.joint_names[j], float(np.rad2deg(travel[i])), float(np.rad2deg(least))))
+    return out
+
+
+def _travels(robot: RobotModel, a: np.ndarray, b: np.ndarray) -> tuple[str, float, str, float]:
+    d = np.abs(b - a)
+    rev = np.array([k == REVOLUTE for k in robot.kinds])
+    j_rev = int(np.argmax(np.where(rev, d, -1.0))) if rev.any() else -1
+    j_pri = int(np.argmax(np.where(~rev, d, -1.0))) if (~rev).any() else -1
+    turn = float(np.rad2deg(d[j_rev])) if j_rev >= 0 else 0.0
+    slide = float(d[j_pri]) if j_pri >= 0 else 0.0
+    return robot.joint_names[j_rev] if turn > 0.0 else "", turn, robot.joint_names[j_pri] if slide > 0.0 else "", slide
+
+
+# ---- tool speed --------------------------------------------------------------------------------------------
+def tool_frame(part: RobotPart) -> str:
+    """The frame whose speed is reported: the program's ``tool_frame``, else the last link (in URDF order) that
+    the program's last driven joint carries (a held gripper's fingers are not the tool)."""
+    if part.spec.task.tool_frame:
+        return part.spec.task.tool_frame
+    last = part.joints.driven[-1]
+    return [name for name, j in part.model.link_joint.items() if j == last][-1]
+
+
+def tool_speeds(part: RobotPart, frame: str, taus: np.ndarray) -> np.ndarray:
+    """The tool frame's speed [m/s] at path times ``taus``: joint positions and speeds from
+    ``robot.trajectory.evaluate`` (the kernel's Python reference), the frame's velocity from pinocchio."""
+    import pinocchio as pin  # heavy: only ``check`` gets here
+
+    robot = part.model
+    model = load_pinocchio(robot.urdf)
+    data = model.createData()
+    fid = model.getFrameId(frame)
+    out = np.empty(len(taus))
+    for k, tau in enumerate(taus):
+        q, qd = evaluate(part.trajectory, float(tau))
+        pin.forwardKinematics(model, data, robot.pinocchio_q(q), qd)
+        out[k] = float(np.linalg.norm(pin.getFrameVelocity(model, data, fid, pin.LOCAL_WORLD_ALIGNED).linear))
+    return out
+
+
+def _move_samples(traj: Trajectory, i: int) -> np.ndarray:
+    """Path times strictly inside move i, at most SPEED_DT apart."""
+    begin, dur = traj.starts[i] + traj.dwells[i], traj.move_times[i]
+    n = 3 if traj.linear else max(MIN_SPEED_SAMPLES, math.ceil(dur / SPEED_DT))
+    return begin + (np.arange(n) + 0.5) / n * dur
+
+
+# ---- the speed bound ---------------------------------------------------------------------------------------
+def peak_joint_speeds(traj: Trajectory) -> np.ndarray:
+    """(moves, joints): each joint's peak speed on each move [rad/s or m/s] (a minimum-jerk move peaks at 15/8 of
+    its mean speed; a linear one runs at its mean)."""
+    w = traj.waypoints
+    d = np.abs(np.roll(w, -1, axis=0) - w)
+    return (1.0 if traj.linear else 1.875) * d / traj.move_times[:, None]
+
+
+def lever_arms(robot: RobotModel, joint: int, point: np.ndarray) -> np.ndarray:
+    """(joints,): for each joint j that carries ``point`` (fixed in ``joint``'s frame) a bound on the speed the
+    point gains per unit of joint j's speed in every configuration, 0 for the others: 1 for a prismatic joint;
+    for a revolute one the point's distance from the joint's origin, bounded by the lengths of the joint
+    placements between them, each prismatic joint's largest travel and the point's own distance, added."""
+    out = np.zeros(robot.n_joints)
+    length = float(np.linalg.norm(point))
+    j = joint
+    while j >= 0:  # from the point's joint towards the base
+        out[j] = length if robot.kinds[j] == REVOLUTE else 1.0
+        length += float(np.linalg.norm(robot.placements[j][:3, 3]))
+        if robot.kinds[j] != REVOLUTE:
+            length += float(max(abs(robot.lower[j]), abs(robot.upper[j])))
+        j = int(robot.parents[j])
+    return out
+
+
+def point_speed_bounds(part: RobotPart) -> np.ndarray:
+    """(moves,): a bound [m/s] on the speed of every point of the robot's capsule axes on each move: per axis
+    end, each joint's peak speed times its lever arm, summed along the chain."""
+    robot, peak = part.model, peak_joint_speeds(part.trajectory)
+    best = np.zeros(len(peak))
+    for c in part.capsules:
+        if c.joint < 0:
+            continue
+        for p in (c.p0, c.p1):
+            best = np.maximum(best, peak @ lever_arms(robot, c.joint, np.asarray(p, float)))
+    return best
+
+
+# ---- capsules over the cycle -------------------------------------------------------------------------------
+def robot_params(layout: Layout, r: int):
+    """``SimParams`` in which robot r's arrays stand where robot 0's do, so ``kernels.robot_live`` poses robot r
+    (its capsules in the first rows of ``Work.ra``): the arrays ``kernels.other_robots`` hands to the same
+    compiled function for it."""
+    P = layout.params
+    if r == 0:
+        return P
+    x = r - 1
+    return P._replace(scal=P.x_scal[x], base=P.x_base[x], parents=P.x_parents[x], placements=P.x_placements[x],
+                      axes=P.x_axes[x], jtype=P.x_jtype[x], anc=P.x_anc[x], wp=P.x_wp[x],
+                      seg_start=P.x_seg_start[x], seg_move=P.x_seg_move[x], seg_dwell=P.x_seg_dwell[x],
+                      cap_joint=P.x_cap_joint[x], cap_a=P.x_cap_a[x], cap_b=P.x_cap_b[x])
+
+
+def capsule_axes(layout: Layout, r: int, taus: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Robot r's capsule axis ends (a, b: (times, capsules, 3)) at path times ``taus``, posed by the kernels as
+    the simulator poses them (``kernels.robot_live``, before any stop)."""
+    P = robot_params(layout, r)
+    W = K.make_work(P)
+    n = len(layout.robots[r].capsules)
+    phase = float(P.scal[L.C_PHASE0])
+    a, b = np.empty((len(taus), n, 3)), np.empty((len(taus), n, 3))
+    for k, tau in enumerate(taus):
+        K.robot_live(P, float(tau) - phase, np.inf, W)
+        a[k], b[k] = W.ra[:n], W.rb[:n]
+    return a, b
+
+
+def sample_times(traj: Trajectory, bounds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(path times, move of each): every move from its start to its end, at most DEPTH / bound apart (the
+    robot rests through each dwell, so a move's first sample stands for it)."""
+    taus, moves = [], []
+    for i in range(traj.n_segments):
+        begin, dur = traj.starts[i] + traj.dwells[i], traj.move_times[i]
+        n = max(1, math.ceil(dur * bounds[i] / DEPTH))
+        taus.append(begin + np.arange(n + 1) / n * dur)
+        moves.append(np.full(n + 1, i))
+    return np.concatenate(taus), np.concatenate(moves)
+
+
+def _axis_points(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(times, points, 3): points along each sample's axis, at most DEPTH apart."""
+    length = float(np.max(np.linalg.norm(b - a, axis=-1))) if len(a) else 0.0
+    u = np.linspace(0.0, 1.0, max(2, math.ceil(length / DEPTH) + 1))
+    return a[:, None, :] + u[None, :, None] * (b - a)[:, None, :]
+
+
+def _prism_depth(pts: np.ndarray, poly: np.ndarray, height: float) -> np.ndarray:
+    """Depth [m] of each point inside the prism raising ``poly`` from the floor to ``height`` (-inf outside)."""
+    depth = np.full(len(pts), -np.inf)
+    lo, hi = poly.min(axis=0) + DEPTH, poly.max(axis=0) - DEPTH
+    near = np.flatnonzero((pts[:, 0] > lo[0]) & (pts[:, 0] < hi[0]) & (pts[:, 1] > lo[1]) & (pts[:, 1] < hi[1])
+                          & (pts[:, 2] > DEPTH) & (pts[:, 2] < height - DEPTH))
+    if len(near) == 0:
+        return depth
+    px, py, pz = pts[near, 0], pts[near, 1], pts[near, 2]
+    inside = points_in_polygon(px, py, poly)
+    plan = distance_to_polyline(px, py, poly, closed=True)
+    depth[near] = np.where(inside, np.minimum(plan, np.minimum(pz, height - pz)), -np.inf)
+    return depth
+
+
+def _fence_panels(layout: Layout) -> list[tuple[str, tuple[float, ...]]]:
+    out = []
+    for f, fence in enumerate(layout.cell.spec.fences):
+        for p, (s, e) in enumerate(zip(fence.points, fence.points[1:], strict=False)):
+            out.append((f"fence {f + 1} panel {p + 1}", (s[0], s[1], e[0], e[1], fence.bottom, fence.top)))
+    return out
+
+
+def _panel_depth(a: np.ndarray, b: np.ndarray, rect: tuple[float, ...]) -> np.ndarray:
+    """DEPTH minus each axis's distance from the panel (positive: within DEPTH of it)."""
+    x0, y0, x1, y1, zlo, zhi = rect
+    lo = np.minimum(a, b) - DEPTH
+    hi = np.maximum(a, b) + DEPTH
+    near = np.flatnonzero((hi[:, 0] >= min(x0, x1)) & (lo[:, 0] <= max(x0, x1)) & (hi[:, 1] >= min(y0, y1))
+                          & (lo[:, 1] <= max(y0, y1)) & (hi[:, 2] >= zlo) & (lo[:, 2] <= zhi))
+    out = np.full(len(a), -np.inf)
+    for k in near:
+        d = segment_rectangle_xyz(a[k, 0], a[k, 1], a[k, 2], b[k, 0], b[k, 1], b[k, 2], x0, y0, x1, y1, zlo,
+                                  zhi)[0]
+        out[k] = DEPTH - d
+    return out
+
+
+def passes_through(layout: Layout, r: int, bounds: np.ndarray) -> tuple[PassThrough, ...]:
+    """Every (move, link, solid) where robot r's capsule axes go more than DEPTH into a solid (or within DEPTH of
+    a fence panel), sampled along each move at most DEPTH / bound apart; the deepest sample of each."""
+    part = layout.robots[r]
+    taus, moves = sample_times(part.trajectory, bounds)
+    solids = [(o.name, np.asarray(o.footprint(), float), float(o.height)) for o in layout.obstacles]
+    panels = _fence_panels(layout)
+    best: dict[tuple[int, str, str], tuple[float, float]] = {}
+
+    def note(sel: np.ndarray, link: str, solid: str, depth: np.ndarray, over: float) -> None:
+        for k in np.flatnonzero(depth > over):
+            key = (int(moves[sel[k]]), link, solid)
+            if key not in best or depth[k] > best[key][0]:
+                best[key] = (float(depth[k]), float(taus[sel[k]]))
+
+    for sel in np.array_split(np.arange(len(taus)), math.ceil(len(taus) / CHUNK)):  # bounded memory
+        a, b = capsule_axes(layout, r, taus[sel])
+        for c, cap in enumerate(part.capsules):
+            if cap.joint < 0:  # the robot's fixed links stand on its pedestal
+                continue
+            pts = _axis_points(a[:, c], b[:, c])  # (times, points, 3)
+            flat = pts.reshape(-1, 3)
+            note(sel, cap.name, "the floor", -pts[:, :, 2].min(axis=1), DEPTH)
+            for name, poly, height in solids:
+                note(sel, cap.name, name, _prism_depth(flat, poly, height).reshape(pts.shape[:2]).max(axis=1), DEPTH)
+            for name, rect in panels:
+                note(sel, cap.name, name, _panel_depth(a[:, c], b[:, c], rect), 0.0)
+    return tuple(PassThrough(m, link, solid, round(d, 4), round(t, 3))
+                 for (m, link, solid), (d, t) in sorted(best.items(), key=lambda kv: (kv[0][0], kv[1][1], kv[0][1:])))
+
+
+# ---- the check ---------------------------------------------------------------------------------------------
+def check_program(layout: Layout, r: int) -> ProgramCheck:
+    part = layout.robots[r]
+    traj, robot, task = part.trajectory, part.model, part.spec.task
+    frame = tool_frame(part)
+    samples = [_move_samples(traj, i) for i in range(traj.n_segments)]
+    speeds = np.split(tool_speeds(part, frame, np.concatenate(samples)), np.cumsum([len(s) for s in samples])[:-1])
+    long_way = long_way_round(robot, traj.waypoints)
+    moves = []
+    for i in range(traj.n_segments):
+        a, b = traj.waypoints[i], traj.waypoints[(i + 1) % traj.n_segments]
+        joint, turn, slide_joint, slide = _travels(robot, a, b)
+        fails = tuple((j, deg, least) for k, j, deg, least in long_way if k == i)
+        moves.append(MoveCheck(i, float(traj.starts[i] + traj.dwells[i]), float(traj.move_times[i]), joint, turn,
+                               slide_joint, slide, float(np.max(speeds[i])), fails))
+    bounds = point_speed_bounds(part)
+    kind = "row" if traj.linear else ("pose" if task.poses else "waypoint")
+    name = part.name if len(layout.robots) > 1 else ""
+    return ProgramCheck(name, frame, kind, traj.cycle, tuple(moves), passes_through(layout, r, bounds),
+                        float(bounds.max()))
+
+
+def check_programs(layout: Layout) -> tuple[ProgramCheck, ...]:
+    """The program check of every robot of the cell, robot 0 first."""
+    return tuple(check_program(layout, r) for r in range(len(layout.robots)))
+
+
+# ---- the lines ``check`` prints ----------------------------------------------------------------------------
+def _move_name(p: ProgramCheck, i: int) -> str:
+    n = len(p.moves)
+    if p.kind == "row":
+        return f"rows {i + 2}-{i + 3}"
+    return f"move {i + 1} ({p.kind} {i + 1} -> {(i + 1) % n + 1})"
+
+
+def program_lines(p: ProgramCheck) -> list[str]:
+    whose = f"robot {p.robot}: " if p.robot else ""
+    out = [f"{whose}{len(p.moves)} moves, cycle {p.cycle:.2f} s, tool {p.tool}; links tested against pedestals, "
+           f"tables, obstacles, fences and the floor at least every {DEPTH * 1000:.0f} mm of capsule travel "
+           f"(capsule points at most {p.speed_bound:.2f} m/s)"]
+    if p.kind == "row":
+        worst = max(p.moves, key=lambda m: m.turn_deg)
+        fast = max(p.moves, key=lambda m: m.tool_speed)
+        out.append(f"  {len(p.moves)} linear moves between the file's rows: largest joint travel "
+                   f"{worst.joint or '-'} {worst.turn_deg:.1f} deg ({_move_name(p, worst.index)}), tool top speed "
+                   f"{fast.tool_speed:.2f} m/s ({_move_name(p, fast.index)})")
+    else:
+        for m in p.moves:
+            slide = f", {m.slide_joint} {m.slide_m:.3f} m" if m.slide_joint else ""
+            out.append(f"  {_move_name(p, m.index)}: {m.duration:.2f} s from t = {m.start:.2f} s, largest joint "
+                       f"travel {m.joint or '-'} {m.turn_deg:.1f} deg{slide}, tool top speed {m.tool_speed:.2f} m/s")
+    fails = [f"  FAIL {_move_name(p, m.index)}: {j} turns {deg:.1f} deg the long way round; whole turns of the "
+             f"waypoints within its limits keep its every move within {least:.1f} deg" for m in p.moves
+             for j, deg, least in m.long_way]
+    for x in p.passes:
+        what = f"comes within {DEPTH - x.depth:.3f} m of" if x.solid.startswith("fence ") else \
+            f"passes {x.depth:.3f} m into" if x.solid != "the floor" else f"passes {x.depth:.3f} m below"
+        fails.append(f"  FAIL {_move_name(p, x.move)}: link {x.link} {what} {x.solid} at t = {x.t:.2f} s")
+    out += fails[:MAX_LISTED]
+    if len(fails) > MAX_LISTED:
+        out.append(f"  ... and {len(fails) - MAX_LISTED} more FAIL lines")
+    if p.ok:
+        out.append("  ok: no move turns a joint the long way round, no link passes through a solid")
+    return out
