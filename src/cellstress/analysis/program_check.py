@@ -1,29 +1,32 @@
 """The robot program check of ``cellstress check``: per move of each robot's program its largest joint travel,
 the tool's top speed and the cycle time, and two failures an integrator would never program.
 
-* **The long way round.** A move that turns a revolute joint by more than 180 deg when the joint's range lets
-  it reach the same angle the other way (the target +- 360 deg within its limits) fails: the robot would sweep
-  more than half a revolution for nothing (docs/robots.md). A joint whose range leaves no other way (a Panda
-  joint of +-166 deg) may turn further: that is the only way there, not a mistake. Joints that follow a
-  ``<mimic>`` master are left to it.
+* **The long way round.** A joint that turns more than 180 deg on a move fails when whole turns of the
+  program's waypoints, within the joint's limits, would keep its longest move shorter
+  (``robot.turns.least_largest_move``). For two waypoints that is: the target +- 360 deg is within the limits.
+  A program cycles, so its moves of one joint add up to nothing, and a cycle through three stations around
+  the base has to turn back the long way once (120 + 120 - 240 deg): that move is needed, and passes. A joint
+  whose range leaves no other way (a Panda joint of +-166 deg) may turn further too: it is the only way there.
+  Joints tied to a ``<mimic>`` joint are left alone (a whole turn would not give the same pose).
 * **Through a solid.** A moving link passes through the robot's own pedestal, the table, an obstacle, a fence
   or the floor when its collision capsule's axis (the core line inside the link's geometry; the capsule's
-  radius only encloses it) goes more than ``DEPTH`` into the solid (below the floor, within ``DEPTH`` of a
-  fence panel, which has no thickness). A link merely touching a surface (a gripper set down on the table, the
-  first link turning on its base) is not: its axis stays outside or at the surface. The robot's fixed links
-  (its base) stand on the pedestal and are not tested.
+  radius only encloses it) goes more than ``DEPTH`` into the solid (below the floor; for a fence panel, which
+  has no thickness, within ``DEPTH`` of it). A link that only touches a surface is not: the baseline's gripper
+  capsule ends exactly on the table top. The robot's fixed links (its base) are not tested, and the links its
+  first joint alone carries are not tested against its own pedestal: they turn on the base by design (the
+  SO-100's shoulder axis lies 19 mm inside the outline of its base).
 
-Sampling, and why it cannot miss a pass: the capsules are posed every ``dt`` of path time by the simulator's own
-kernels (as ``sim.scene.robot_capsules`` poses them), with ``dt = DEPTH / v_bound``, where ``v_bound`` bounds
-the speed of every point of every capsule axis over the whole program (``point_speed_bound``: each joint's peak
-speed on its move times its largest lever arm to the point, summed along the chain; an axis point is a convex
-combination of the axis's ends, so no point is faster than the faster end). Along each axis the depth is read
-at points at most ``DEPTH`` apart. Depth inside a solid is 1-Lipschitz in the point, so an axis point that at
-any instant lies ``2 DEPTH`` deep is, at the nearest sample (``dt / 2`` away, ``DEPTH / 2`` of travel) and at the
-nearest point along the axis (``DEPTH / 2`` away), still more than ``DEPTH`` deep, and is reported; nothing
-shallower than ``DEPTH`` is. For a fence panel the same bound puts an axis that crosses it within
-``DEPTH / 2`` of it at the nearest sample. A solid thinner than ``4 DEPTH`` (4 cm) could let a pass through it
-go unreported; fences are tested as panels for that reason.
+Sampling, and why it cannot miss a pass: on each move the capsules are posed by the simulator's own kernels
+(``kernels.robot_live``, as ``sim.scene.robot_capsules`` poses them) at path times at most ``DEPTH / v`` apart,
+where ``v`` bounds the speed of every point of every capsule axis on that move (``point_speed_bounds``: each
+joint's peak speed times its largest lever arm to the point, summed along the chain; an axis point is a convex
+combination of the axis's ends, so it is no faster than the faster end); a dwell is a pose at rest, the move's
+first sample. Along each axis the depth is read at points at most ``DEPTH`` apart. Depth inside a solid is
+1-Lipschitz in the point, so an axis point that at any instant lies ``2 DEPTH`` deep is, at the nearest sample
+(at most ``DEPTH / 2`` of travel away) and at the nearest point along the axis (``DEPTH / 2``), still more than
+``DEPTH`` deep, and is reported; nothing shallower than ``DEPTH`` is. For a fence panel the same bound puts an
+axis that crosses it within ``DEPTH / 2`` of it at the nearest sample. A solid thinner than ``4 DEPTH`` (4 cm)
+could let a pass go unreported; fences are tested as panels for that reason.
 """
 
 from __future__ import annotations
@@ -34,12 +37,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from cellstress.analysis.plane import distance_to_polyline, points_in_polygon
+from cellstress.robot.ik import frame_index
 from cellstress.robot.model import REVOLUTE, RobotModel, load_pinocchio
 from cellstress.robot.trajectory import Trajectory, evaluate
 from cellstress.robot.turns import EPS, least_largest_move, turns_freely
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
-from cellstress.sim.build import Layout, RobotPart
+from cellstress.sim.build import PEDESTAL, Layout, RobotPart
 from cellstress.sim.geometry import segment_rectangle_xyz
 
 DEPTH = 0.01  # m: a capsule axis this far inside a solid (or this near a fence panel) passes through it
@@ -148,7 +152,7 @@ def tool_speeds(part: RobotPart, frame: str, taus: np.ndarray) -> np.ndarray:
     robot = part.model
     model = load_pinocchio(robot.urdf)
     data = model.createData()
-    fid = model.getFrameId(frame)
+    fid = frame_index(pin, model, frame)
     out = np.empty(len(taus))
     for k, tau in enumerate(taus):
         q, qd = evaluate(part.trajectory, float(tau))
@@ -289,12 +293,21 @@ def _panel_depth(a: np.ndarray, b: np.ndarray, rect: tuple[float, ...]) -> np.nd
     return out
 
 
+def own_pedestal(layout: Layout, r: int) -> int:
+    """The index in ``layout.obstacles`` of robot r's own pedestal (``sim.build.pedestal``: after the cell's
+    obstacles, one per robot that has one, in robot order), or -1."""
+    first = len(layout.cell.spec.solid_obstacles())
+    name = PEDESTAL if len(layout.robots) == 1 else f"{layout.robots[r].name}-pedestal"
+    return next((i for i in range(first, len(layout.obstacles)) if layout.obstacles[i].name == name), -1)
+
+
 def passes_through(layout: Layout, r: int, bounds: np.ndarray) -> tuple[PassThrough, ...]:
     """Every (move, link, solid) where robot r's capsule axes go more than DEPTH into a solid (or within DEPTH of
     a fence panel), sampled along each move at most DEPTH / bound apart; the deepest sample of each."""
     part = layout.robots[r]
     taus, moves = sample_times(part.trajectory, bounds)
     solids = [(o.name, np.asarray(o.footprint(), float), float(o.height)) for o in layout.obstacles]
+    own = own_pedestal(layout, r)
     panels = _fence_panels(layout)
     best: dict[tuple[int, str, str], tuple[float, float]] = {}
 
@@ -312,7 +325,9 @@ def passes_through(layout: Layout, r: int, bounds: np.ndarray) -> tuple[PassThro
             pts = _axis_points(a[:, c], b[:, c])  # (times, points, 3)
             flat = pts.reshape(-1, 3)
             note(sel, cap.name, "the floor", -pts[:, :, 2].min(axis=1), DEPTH)
-            for name, poly, height in solids:
+            for i, (name, poly, height) in enumerate(solids):
+                if i == own and part.model.parents[cap.joint] < 0:  # the first link turns on its base by design
+                    continue
                 note(sel, cap.name, name, _prism_depth(flat, poly, height).reshape(pts.shape[:2]).max(axis=1), DEPTH)
             for name, rect in panels:
                 note(sel, cap.name, name, _panel_depth(a[:, c], b[:, c], rect), 0.0)

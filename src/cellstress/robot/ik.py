@@ -129,6 +129,16 @@ def _choose(found: list[np.ndarray], refs: list[np.ndarray], vmax: np.ndarray) -
     return min(found, key=cost)
 
 
+def frame_index(pin, model, frame: str) -> int:
+    """Pinocchio's index of the frame named ``frame``: a link (a joint may share its name, as the SO-100's
+    ``gripper`` does), else any frame of that name; CellstressError naming the links if there is none."""
+    for kind in (pin.FrameType.BODY, None):
+        if model.existFrame(frame) if kind is None else model.existFrame(frame, kind):
+            return int(model.getFrameId(frame) if kind is None else model.getFrameId(frame, kind))
+    frames = sorted({f.name for f in model.frames if f.type == pin.FrameType.BODY})
+    raise CellstressError(f"the robot has no frame {frame!r}; its links are {', '.join(frames)}")
+
+
 def solve_poses(jmap: JointMap, frame: str, targets: list[np.ndarray], seed: np.ndarray) -> np.ndarray:
     """Driven joint values (n, nd) for each 4x4 target of ``frame`` in the robot's base frame, in order,
     starting from the configuration ``seed`` (the first waypoint is the solution nearest it)."""
@@ -136,10 +146,7 @@ def solve_poses(jmap: JointMap, frame: str, targets: list[np.ndarray], seed: np.
 
     robot = jmap.robot
     model = load_pinocchio(robot.urdf)
-    if not model.existFrame(frame):
-        frames = sorted({f.name for f in model.frames if f.type == pin.FrameType.BODY})
-        raise CellstressError(f"the robot has no frame {frame!r}; its links are {', '.join(frames)}")
-    frame_id = model.getFrameId(frame)
+    frame_id = frame_index(pin, model, frame)
     data = model.createData()
     e = jmap.jacobian_map()
     driven = list(jmap.driven)
