@@ -384,15 +384,19 @@ def program_lines(p: ProgramCheck) -> list[str]:
     else:
         for m in p.moves:
             slide = f", {m.slide_joint} {m.slide_m:.3f} m" if m.slide_joint else ""
-            out.append(f"  {_move_name(p, m.index)}: {m.duration:.2f} s from t = {m.start:.2f} s, largest joint "
-                       f"travel {m.joint or '-'} {m.turn_deg:.1f} deg{slide}, tool top speed {m.tool_speed:.2f} m/s")
+            out.append(f"  {_move_name(p, m.index)}: {m.duration:.2f} s from {m.start:.2f} s of the cycle, "
+                       f"largest joint travel {m.joint or '-'} {m.turn_deg:.1f} deg{slide}, tool top speed "
+                       f"{m.tool_speed:.2f} m/s")
     fails = [f"  FAIL {_move_name(p, m.index)}: {j} turns {deg:.1f} deg the long way round; whole turns of the "
              f"waypoints within its limits keep its every move within {least:.1f} deg" for m in p.moves
              for j, deg, least in m.long_way]
     for x in p.passes:
-        what = f"comes within {DEPTH - x.depth:.3f} m of" if x.solid.startswith("fence ") else \
-            f"passes {x.depth:.3f} m into" if x.solid != "the floor" else f"passes {x.depth:.3f} m below"
-        fails.append(f"  FAIL {_move_name(p, x.move)}: link {x.link} {what} {x.solid} at t = {x.t:.2f} s")
+        if x.solid.startswith("fence "):
+            gap = DEPTH - x.depth
+            what = "passes through" if gap < 5e-4 else f"comes within {gap * 1000:.0f} mm of"
+        else:
+            what = f"passes {x.depth:.3f} m {'below' if x.solid == 'the floor' else 'into'}"
+        fails.append(f"  FAIL {_move_name(p, x.move)}: link {x.link} {what} {x.solid} at {x.t:.2f} s of the cycle")
     out += fails[:MAX_LISTED]
     if len(fails) > MAX_LISTED:
         out.append(f"  ... and {len(fails) - MAX_LISTED} more FAIL lines")
