@@ -32,7 +32,7 @@ BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intr
                                   "warning-field-ok", "mat-short", "mat-ok", "palletizing", "palletizing-fixed",
                                   "door-unlocked", "door-locked", "muting-long", "muting-ok",
                                   "two-robots", "two-robots-fixed", "ssm-latency", "ssm-ok", "reach-over",
-                                  "reach-over-ok")
+                                  "reach-over-ok", "machine-tending")
 
 
 @dataclass(frozen=True)
