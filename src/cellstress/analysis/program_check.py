@@ -11,22 +11,24 @@ the tool's top speed and the cycle time, and two failures an integrator would ne
 * **Through a solid.** A moving link passes through the robot's own pedestal, the table, an obstacle, a fence
   or the floor when its collision capsule's axis (the core line inside the link's geometry; the capsule's
   radius only encloses it) goes more than ``DEPTH`` into the solid (below the floor; for a fence panel, which
-  has no thickness, within ``DEPTH`` of it). A link that only touches a surface is not: the baseline's gripper
-  capsule ends exactly on the table top. The robot's fixed links (its base) are not tested, and the links its
-  first joint alone carries are not tested against its own pedestal: they turn on the base by design (the
-  SO-100's shoulder axis lies 19 mm inside the outline of its base).
+  has no thickness, a point of it within ``DEPTH`` of the panel). A link that only touches a surface is not:
+  the baseline's gripper capsule ends exactly on the table top. The robot's fixed links (its base) are not
+  tested, and the links its first joint alone carries are not tested against its own pedestal: they turn on
+  the base by design (the SO-100's shoulder axis lies 19 mm inside the outline of its base).
 
 Sampling, and why it cannot miss a pass: on each move the capsules are posed by the simulator's own kernels
-(``kernels.robot_live``, as ``sim.scene.robot_capsules`` poses them) at path times at most ``DEPTH / v`` apart,
+(``kernels.robot_live``, as ``sim.scene.robot_capsules`` poses them) at path times at most ``step / v`` apart,
 where ``v`` bounds the speed of every point of every capsule axis on that move (``point_speed_bounds``: each
 joint's peak speed times its largest lever arm to the point, summed along the chain; an axis point is a convex
 combination of the axis's ends, so it is no faster than the faster end); a dwell is a pose at rest, the move's
-first sample. Along each axis the depth is read at points at most ``DEPTH`` apart. Depth inside a solid is
-1-Lipschitz in the point, so an axis point that at any instant lies ``2 DEPTH`` deep is, at the nearest sample
-(at most ``DEPTH / 2`` of travel away) and at the nearest point along the axis (``DEPTH / 2``), still more than
-``DEPTH`` deep, and is reported; nothing shallower than ``DEPTH`` is. For a fence panel the same bound puts an
-axis that crosses it within ``DEPTH / 2`` of it at the nearest sample. A solid thinner than ``4 DEPTH`` (4 cm)
-could let a pass go unreported; fences are tested as panels for that reason.
+first sample. Along each axis the depth is read at points at most ``step`` apart. ``step`` is ``DEPTH``
+(``sample_spacing`` widens it only for a program that would need more than ``MAX_POINTS`` axis points, a
+cycle of minutes at high speed, and the header prints the spacing used). Depth inside a solid is 1-Lipschitz
+in the point, so an axis point that at any instant lies ``DEPTH + step`` deep (20 mm) is, at the nearest
+sample (``step / 2`` of travel away) and the nearest point along the axis (``step / 2``), still more than
+``DEPTH`` deep, and is reported; nothing shallower than ``DEPTH`` is. An axis that crosses a fence panel has,
+at the nearest sample, a point within ``step`` of it, and is reported. A solid thinner than
+``2 (DEPTH + step)`` (40 mm) could let a pass go unreported; fences are tested as panels for that reason.
 """
 
 from __future__ import annotations
@@ -44,12 +46,13 @@ from cellstress.robot.turns import EPS, least_largest_move, turns_freely
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 from cellstress.sim.build import PEDESTAL, Layout, RobotPart
-from cellstress.sim.geometry import segment_rectangle_xyz
 
 DEPTH = 0.01  # m: a capsule axis this far inside a solid (or this near a fence panel) passes through it
-SPEED_DT = 0.005  # s of path time between the tool speed's samples along a move
-MIN_SPEED_SAMPLES = 64  # per move (3 per row of a trajectory file's short linear moves)
-CHUNK = 2048  # capsule samples posed and measured at once
+SPEED_DT = 0.02  # s of path time between the tool speed's samples along a move
+MIN_SPEED_SAMPLES = 64  # per minimum-jerk move
+MAX_SPEED_ROWS = 20_000  # a trajectory file's rows whose tool speed is taken, at most (time)
+CHUNK_POINTS = 400_000  # axis points measured at once (memory)
+MAX_POINTS = 40_000_000  # axis points over a robot's cycle, at most (time)
 MAX_LISTED = 12  # failure lines listed per robot; the rest are counted
 HALF_TURN = math.pi
 
@@ -65,7 +68,7 @@ class MoveCheck:
     turn_deg: float  # its travel [deg]
     slide_joint: str  # the prismatic joint sliding most ('' if none slides)
     slide_m: float  # its travel [m]
-    tool_speed: float  # m/s, the tool frame's top speed along the move
+    tool_speed: float  # m/s, the tool frame's top speed along the move (NaN: not taken, ``speed_stride``)
     long_way: tuple[tuple[str, float, float], ...]  # (joint, travel deg, least largest travel deg): each a FAIL
 
 
@@ -90,7 +93,9 @@ class ProgramCheck:
     cycle: float  # s
     moves: tuple[MoveCheck, ...]
     passes: tuple[PassThrough, ...]
-    speed_bound: float  # m/s, the largest bound on capsule axis point speed (samples are DEPTH / bound apart)
+    speed_bound: float  # m/s, the largest bound on capsule axis point speed
+    spacing: float  # m of capsule travel between samples, and between points along an axis (DEPTH, or more)
+    speed_stride: int = 1  # a trajectory file's tool speed taken every this many rows (the others NaN)
 
     @property
     def ok(self) -> bool:
@@ -124,14 +129,17 @@ def long_way_round(robot: RobotModel, waypoints: np.ndarray) -> list[tuple[int, 
     return out
 
 
-def _travels(robot: RobotModel, a: np.ndarray, b: np.ndarray) -> tuple[str, float, str, float]:
-    d = np.abs(b - a)
+def travels(robot: RobotModel, waypoints: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per move (waypoint i to the next, the last back to the first): the revolute joint turning most and its
+    travel [deg], the prismatic joint sliding most and its travel [m] (joint -1 and 0 where none moves)."""
+    d = np.abs(np.roll(waypoints, -1, axis=0) - waypoints)
     rev = np.array([k == REVOLUTE for k in robot.kinds])
-    j_rev = int(np.argmax(np.where(rev, d, -1.0))) if rev.any() else -1
-    j_pri = int(np.argmax(np.where(~rev, d, -1.0))) if (~rev).any() else -1
-    turn = float(np.rad2deg(d[j_rev])) if j_rev >= 0 else 0.0
-    slide = float(d[j_pri]) if j_pri >= 0 else 0.0
-    return robot.joint_names[j_rev] if turn > 0.0 else "", turn, robot.joint_names[j_pri] if slide > 0.0 else "", slide
+    turn = np.where(rev[None, :], d, -1.0)
+    slide = np.where(~rev[None, :], d, -1.0)
+    j_rev, j_pri = np.argmax(turn, axis=1), np.argmax(slide, axis=1)
+    deg = np.rad2deg(np.maximum(turn.max(axis=1), 0.0))
+    metres = np.maximum(slide.max(axis=1), 0.0)
+    return np.where(deg > 0.0, j_rev, -1), deg, np.where(metres > 0.0, j_pri, -1), metres
 
 
 # ---- tool speed --------------------------------------------------------------------------------------------
@@ -144,28 +152,43 @@ def tool_frame(part: RobotPart) -> str:
     return [name for name, j in part.model.link_joint.items() if j == last][-1]
 
 
-def tool_speeds(part: RobotPart, frame: str, taus: np.ndarray) -> np.ndarray:
-    """The tool frame's speed [m/s] at path times ``taus``: joint positions and speeds from
-    ``robot.trajectory.evaluate`` (the kernel's Python reference), the frame's velocity from pinocchio."""
+def tool_speeds(part: RobotPart, frame: str, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """The tool frame's speed [m/s] at joint positions q and speeds qd (rows), by pinocchio's kinematics."""
     import pinocchio as pin  # heavy: only ``check`` gets here
 
     robot = part.model
     model = load_pinocchio(robot.urdf)
     data = model.createData()
     fid = frame_index(pin, model, frame)
-    out = np.empty(len(taus))
-    for k, tau in enumerate(taus):
-        q, qd = evaluate(part.trajectory, float(tau))
-        pin.forwardKinematics(model, data, robot.pinocchio_q(q), qd)
+    out = np.empty(len(q))
+    for k in range(len(q)):
+        pin.forwardKinematics(model, data, robot.pinocchio_q(q[k]), qd[k])
         out[k] = float(np.linalg.norm(pin.getFrameVelocity(model, data, fid, pin.LOCAL_WORLD_ALIGNED).linear))
     return out
 
 
-def _move_samples(traj: Trajectory, i: int) -> np.ndarray:
-    """Path times strictly inside move i, at most SPEED_DT apart."""
-    begin, dur = traj.starts[i] + traj.dwells[i], traj.move_times[i]
-    n = 3 if traj.linear else max(MIN_SPEED_SAMPLES, math.ceil(dur / SPEED_DT))
-    return begin + (np.arange(n) + 0.5) / n * dur
+def move_speeds(part: RobotPart, frame: str) -> tuple[np.ndarray, int]:
+    """(the tool's top speed on each move [m/s], every how many rows of a trajectory file it was taken).
+
+    A minimum-jerk move is sampled at least every SPEED_DT of path time (at least MIN_SPEED_SAMPLES times),
+    joint positions and speeds from ``robot.trajectory.evaluate`` (the kernel's Python reference). A trajectory
+    file's move runs at constant joint speed, taken at the row's middle, every row up to MAX_SPEED_ROWS rows and
+    evenly spaced rows beyond (the others NaN)."""
+    traj = part.trajectory
+    if traj.linear:
+        stride = max(1, math.ceil(traj.n_segments / MAX_SPEED_ROWS))
+        rows = np.arange(0, traj.n_segments, stride)
+        a, b = traj.waypoints[rows], traj.waypoints[(rows + 1) % traj.n_segments]
+        out = np.full(traj.n_segments, np.nan)
+        out[rows] = tool_speeds(part, frame, 0.5 * (a + b), (b - a) / traj.move_times[rows, None])
+        return out, stride
+    out = np.zeros(traj.n_segments)
+    for i in range(traj.n_segments):
+        begin, dur = traj.starts[i] + traj.dwells[i], traj.move_times[i]
+        n = max(MIN_SPEED_SAMPLES, math.ceil(dur / SPEED_DT))
+        q, qd = zip(*(evaluate(traj, float(t)) for t in begin + (np.arange(n) + 0.5) / n * dur), strict=True)
+        out[i] = float(np.max(tool_speeds(part, frame, np.asarray(q), np.asarray(qd))))
+    return out, 1
 
 
 # ---- the speed bound ---------------------------------------------------------------------------------------
@@ -236,27 +259,76 @@ def capsule_axes(layout: Layout, r: int, taus: np.ndarray) -> tuple[np.ndarray, 
     return a, b
 
 
-def sample_times(traj: Trajectory, bounds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(path times, move of each): every move from its start to its end, at most DEPTH / bound apart (the
-    robot rests through each dwell, so a move's first sample stands for it)."""
-    taus, moves = [], []
-    for i in range(traj.n_segments):
-        begin, dur = traj.starts[i] + traj.dwells[i], traj.move_times[i]
-        n = max(1, math.ceil(dur * bounds[i] / DEPTH))
-        taus.append(begin + np.arange(n + 1) / n * dur)
-        moves.append(np.full(n + 1, i))
-    return np.concatenate(taus), np.concatenate(moves)
+def capsule_grid(layout: Layout, r: int, t0: float, dt: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``capsule_axes`` at the n path times t0 + k dt, in one compiled loop: ``kernels.robot_table`` (the
+    pre-stop table the simulator fills the same way) with the phase at t0 and the time step dt."""
+    P = robot_params(layout, r)
+    scal = P.scal.copy()
+    scal[L.C_PHASE0], scal[L.C_DT] = t0, dt
+    P = P._replace(scal=scal, x_scal=np.zeros((0, scal.shape[0])))  # the other robots are not posed
+    nc = P.cap_r.shape[0]
+    a, b = np.empty((n, nc, 3)), np.empty((n, nc, 3))
+    K.robot_table(P, n, a, b, np.empty(n), np.empty(n), np.empty((n, 0)), np.empty((n, 0)))
+    m = len(layout.robots[r].capsules)
+    return a[:, :m], b[:, :m]
 
 
-def _axis_points(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(times, points, 3): points along each sample's axis, at most DEPTH apart."""
+def sample_spacing(part: RobotPart, bounds: np.ndarray) -> float:
+    """The capsule travel [m] between samples and between points along an axis: DEPTH, unless that needs more
+    than MAX_POINTS axis points over the cycle (a cycle of minutes at high speed), then as much more as keeps
+    them within it (the work, and the time ``check`` takes, stay bounded; the header says the spacing used)."""
+    traj = part.trajectory
+    moving = [c for c in part.capsules if c.joint >= 0]
+    lengths = np.array([float(np.linalg.norm(np.subtract(c.p1, c.p0))) for c in moving])
+
+    def points(step: float) -> float:
+        samples = float(sum(n for _, _, n in sample_grids(traj, bounds, step)))
+        return samples * float(np.sum(np.ceil(lengths / step) + 1))
+
+    step = DEPTH
+    if moving and points(step) > MAX_POINTS:
+        step *= math.sqrt(points(step) / MAX_POINTS)
+        while points(step) > MAX_POINTS:  # (the ceilings: a few percent more at most)
+            step *= 1.05
+    return step
+
+
+def sample_grids(traj: Trajectory, bounds: np.ndarray, step: float = DEPTH) -> list[tuple[float, float, int]]:
+    """(first path time, time step, samples) of each stretch sampled evenly: each move of a waypoint program
+    from its start to its end (the robot rests through each dwell, so a move's first sample stands for it); a
+    trajectory file's rows, short moves without dwells, as one stretch over the cycle. Samples lie at most
+    ``step`` / bound apart."""
+    if traj.linear:
+        n = max(1, math.ceil(traj.cycle * float(bounds.max()) / step))
+        return [(0.0, traj.cycle / n, n + 1)]
+    n = np.maximum(1, np.ceil(traj.move_times * bounds / step)).astype(np.int64)
+    begin = traj.starts + traj.dwells
+    return [(float(begin[i]), float(traj.move_times[i] / n[i]), int(n[i]) + 1) for i in range(len(n))]
+
+
+def move_of(traj: Trajectory, taus: np.ndarray) -> np.ndarray:
+    """The move each path time belongs to (a waypoint's dwell counts to the move after it; the cycle's end to
+    the last move)."""
+    return np.clip(np.searchsorted(traj.starts, np.minimum(taus, traj.cycle), side="right") - 1, 0,
+                   traj.n_segments - 1)
+
+
+def sample_times(traj: Trajectory, bounds: np.ndarray, step: float = DEPTH) -> tuple[np.ndarray, np.ndarray]:
+    """The path times of ``sample_grids`` and the move of each."""
+    taus = np.concatenate([t0 + np.arange(n) * dt for t0, dt, n in sample_grids(traj, bounds, step)])
+    return taus, move_of(traj, taus)
+
+
+def _axis_points(a: np.ndarray, b: np.ndarray, step: float) -> np.ndarray:
+    """(times, points, 3): points along each sample's axis, at most ``step`` apart."""
     length = float(np.max(np.linalg.norm(b - a, axis=-1))) if len(a) else 0.0
-    u = np.linspace(0.0, 1.0, max(2, math.ceil(length / DEPTH) + 1))
+    u = np.linspace(0.0, 1.0, max(2, math.ceil(length / step) + 1))
     return a[:, None, :] + u[None, :, None] * (b - a)[:, None, :]
 
 
 def _prism_depth(pts: np.ndarray, poly: np.ndarray, height: float) -> np.ndarray:
-    """Depth [m] of each point inside the prism raising ``poly`` from the floor to ``height`` (-inf outside)."""
+    """Depth [m] of each point inside the prism raising ``poly`` from the floor to ``height`` (-inf outside or
+    within DEPTH of its surface)."""
     depth = np.full(len(pts), -np.inf)
     lo, hi = poly.min(axis=0) + DEPTH, poly.max(axis=0) - DEPTH
     near = np.flatnonzero((pts[:, 0] > lo[0]) & (pts[:, 0] < hi[0]) & (pts[:, 1] > lo[1]) & (pts[:, 1] < hi[1])
@@ -270,27 +342,26 @@ def _prism_depth(pts: np.ndarray, poly: np.ndarray, height: float) -> np.ndarray
     return depth
 
 
-def _fence_panels(layout: Layout) -> list[tuple[str, tuple[float, ...]]]:
-    out = []
+def _fence_panels(layout: Layout) -> tuple[list[str], np.ndarray]:
+    """The fence panels' names and (x0, y0, x1, y1, bottom, top) rows."""
+    names, rects = [], []
     for f, fence in enumerate(layout.cell.spec.fences):
         for p, (s, e) in enumerate(zip(fence.points, fence.points[1:], strict=False)):
-            out.append((f"fence {f + 1} panel {p + 1}", (s[0], s[1], e[0], e[1], fence.bottom, fence.top)))
-    return out
+            names.append(f"fence {f + 1} panel {p + 1}")
+            rects.append((s[0], s[1], e[0], e[1], fence.bottom, fence.top))
+    return names, np.asarray(rects, dtype=float).reshape(-1, 6)
 
 
-def _panel_depth(a: np.ndarray, b: np.ndarray, rect: tuple[float, ...]) -> np.ndarray:
-    """DEPTH minus each axis's distance from the panel (positive: within DEPTH of it)."""
+def panel_distances(pts: np.ndarray, rect: np.ndarray) -> np.ndarray:
+    """Distance [m] of each point from the vertical rectangle over the floor segment (x0, y0)-(x1, y1) between
+    heights bottom and top."""
     x0, y0, x1, y1, zlo, zhi = rect
-    lo = np.minimum(a, b) - DEPTH
-    hi = np.maximum(a, b) + DEPTH
-    near = np.flatnonzero((hi[:, 0] >= min(x0, x1)) & (lo[:, 0] <= max(x0, x1)) & (hi[:, 1] >= min(y0, y1))
-                          & (lo[:, 1] <= max(y0, y1)) & (hi[:, 2] >= zlo) & (lo[:, 2] <= zhi))
-    out = np.full(len(a), -np.inf)
-    for k in near:
-        d = segment_rectangle_xyz(a[k, 0], a[k, 1], a[k, 2], b[k, 0], b[k, 1], b[k, 2], x0, y0, x1, y1, zlo,
-                                  zhi)[0]
-        out[k] = DEPTH - d
-    return out
+    d = np.array([x1 - x0, y1 - y0])
+    w2 = float(d @ d)
+    t = np.clip(((pts[:, 0] - x0) * d[0] + (pts[:, 1] - y0) * d[1]) / w2, 0.0, 1.0) if w2 > 0 else 0.0
+    dx, dy = pts[:, 0] - (x0 + t * d[0]), pts[:, 1] - (y0 + t * d[1])
+    dz = pts[:, 2] - np.clip(pts[:, 2], zlo, zhi)
+    return np.sqrt(dx * dx + dy * dy + dz * dz)
 
 
 def own_pedestal(layout: Layout, r: int) -> int:
@@ -301,36 +372,54 @@ def own_pedestal(layout: Layout, r: int) -> int:
     return next((i for i in range(first, len(layout.obstacles)) if layout.obstacles[i].name == name), -1)
 
 
-def passes_through(layout: Layout, r: int, bounds: np.ndarray) -> tuple[PassThrough, ...]:
-    """Every (move, link, solid) where robot r's capsule axes go more than DEPTH into a solid (or within DEPTH of
-    a fence panel), sampled along each move at most DEPTH / bound apart; the deepest sample of each."""
+def passes_through(layout: Layout, r: int, bounds: np.ndarray, step: float = DEPTH) -> tuple[PassThrough, ...]:
+    """Every (move, link, solid) where robot r's capsule axes go more than DEPTH into a solid (for a fence
+    panel: an axis point within DEPTH of it), sampled along each move at most ``step`` of capsule travel apart,
+    with points at most ``step`` apart along each axis; the deepest sample of each."""
     part = layout.robots[r]
-    taus, moves = sample_times(part.trajectory, bounds)
     solids = [(o.name, np.asarray(o.footprint(), float), float(o.height)) for o in layout.obstacles]
     own = own_pedestal(layout, r)
-    panels = _fence_panels(layout)
+    panel_names, rects = _fence_panels(layout)
     best: dict[tuple[int, str, str], tuple[float, float]] = {}
 
-    def note(sel: np.ndarray, link: str, solid: str, depth: np.ndarray, over: float) -> None:
-        for k in np.flatnonzero(depth > over):
-            key = (int(moves[sel[k]]), link, solid)
+    def note(moves: np.ndarray, taus: np.ndarray, link: str, solid: str, depth: np.ndarray, over: float) -> None:
+        hit = np.flatnonzero(depth > over)
+        for move in np.unique(moves[hit]):  # the deepest sample of each move
+            k = hit[moves[hit] == move]
+            k = int(k[np.argmax(depth[k])])
+            key = (int(move), link, solid)
             if key not in best or depth[k] > best[key][0]:
-                best[key] = (float(depth[k]), float(taus[sel[k]]))
+                best[key] = (float(depth[k]), float(taus[k]))
 
-    for sel in np.array_split(np.arange(len(taus)), math.ceil(len(taus) / CHUNK)):  # bounded memory
-        a, b = capsule_axes(layout, r, taus[sel])
-        for c, cap in enumerate(part.capsules):
-            if cap.joint < 0:  # the robot's fixed links stand on its pedestal
-                continue
-            pts = _axis_points(a[:, c], b[:, c])  # (times, points, 3)
-            flat = pts.reshape(-1, 3)
-            note(sel, cap.name, "the floor", -pts[:, :, 2].min(axis=1), DEPTH)
-            for i, (name, poly, height) in enumerate(solids):
-                if i == own and part.model.parents[cap.joint] < 0:  # the first link turns on its base by design
+    per_sample = sum(max(2, math.ceil(float(np.linalg.norm(np.subtract(c.p1, c.p0))) / step) + 1)
+                     for c in part.capsules)
+    chunk = max(2, CHUNK_POINTS // per_sample)
+    for t0, dt, n in sample_grids(part.trajectory, bounds, step):
+        for k0 in range(0, n, chunk):  # bounded memory
+            m = min(chunk, n - k0)
+            taus = t0 + (k0 + np.arange(m)) * dt
+            moves = move_of(part.trajectory, taus)
+            a, b = capsule_grid(layout, r, t0 + k0 * dt, dt, m)
+            for c, cap in enumerate(part.capsules):
+                if cap.joint < 0:  # the robot's fixed links stand on its pedestal
                     continue
-                note(sel, cap.name, name, _prism_depth(flat, poly, height).reshape(pts.shape[:2]).max(axis=1), DEPTH)
-            for name, rect in panels:
-                note(sel, cap.name, name, _panel_depth(a[:, c], b[:, c], rect), 0.0)
+                pts = _axis_points(a[:, c], b[:, c], step)  # (times, points, 3)
+                flat = pts.reshape(-1, 3)
+                note(moves, taus, cap.name, "the floor", -pts[:, :, 2].min(axis=1), DEPTH)
+                for i, (name, poly, height) in enumerate(solids):
+                    if i == own and part.model.parents[cap.joint] < 0:  # the first link turns on its base by design
+                        continue
+                    depth = _prism_depth(flat, poly, height).reshape(pts.shape[:2]).max(axis=1)
+                    note(moves, taus, cap.name, name, depth, DEPTH)
+                lo, hi = flat.min(axis=0) - DEPTH, flat.max(axis=0) + DEPTH
+                near = np.flatnonzero((np.maximum(rects[:, 0], rects[:, 2]) >= lo[0])
+                                      & (np.minimum(rects[:, 0], rects[:, 2]) <= hi[0])
+                                      & (np.maximum(rects[:, 1], rects[:, 3]) >= lo[1])
+                                      & (np.minimum(rects[:, 1], rects[:, 3]) <= hi[1])
+                                      & (rects[:, 5] >= lo[2]) & (rects[:, 4] <= hi[2]))
+                for i in near:
+                    gap = panel_distances(flat, rects[i]).reshape(pts.shape[:2]).min(axis=1)
+                    note(moves, taus, cap.name, panel_names[i], DEPTH - gap, -1e-12)
     return tuple(PassThrough(m, link, solid, round(d, 4), round(t, 3))
                  for (m, link, solid), (d, t) in sorted(best.items(), key=lambda kv: (kv[0][0], kv[1][1], kv[0][1:])))
 
@@ -340,21 +429,20 @@ def check_program(layout: Layout, r: int) -> ProgramCheck:
     part = layout.robots[r]
     traj, robot, task = part.trajectory, part.model, part.spec.task
     frame = tool_frame(part)
-    samples = [_move_samples(traj, i) for i in range(traj.n_segments)]
-    speeds = np.split(tool_speeds(part, frame, np.concatenate(samples)), np.cumsum([len(s) for s in samples])[:-1])
+    speeds, stride = move_speeds(part, frame)
     long_way = long_way_round(robot, traj.waypoints)
-    moves = []
-    for i in range(traj.n_segments):
-        a, b = traj.waypoints[i], traj.waypoints[(i + 1) % traj.n_segments]
-        joint, turn, slide_joint, slide = _travels(robot, a, b)
-        fails = tuple((j, deg, least) for k, j, deg, least in long_way if k == i)
-        moves.append(MoveCheck(i, float(traj.starts[i] + traj.dwells[i]), float(traj.move_times[i]), joint, turn,
-                               slide_joint, slide, float(np.max(speeds[i])), fails))
+    j_rev, deg, j_pri, metres = travels(robot, traj.waypoints)
+    name_of = ("", *robot.joint_names)  # index j + 1: joint -1 is none
+    moves = tuple(MoveCheck(i, float(traj.starts[i] + traj.dwells[i]), float(traj.move_times[i]),
+                            name_of[j_rev[i] + 1], float(deg[i]), name_of[j_pri[i] + 1], float(metres[i]),
+                            float(speeds[i]), tuple((j, d, least) for k, j, d, least in long_way if k == i))
+                  for i in range(traj.n_segments))
     bounds = point_speed_bounds(part)
+    step = sample_spacing(part, bounds)
     kind = "row" if traj.linear else ("pose" if task.poses else "waypoint")
     name = part.name if len(layout.robots) > 1 else ""
-    return ProgramCheck(name, frame, kind, traj.cycle, tuple(moves), passes_through(layout, r, bounds),
-                        float(bounds.max()))
+    return ProgramCheck(name, frame, kind, traj.cycle, moves, passes_through(layout, r, bounds, step),
+                        float(bounds.max()), step, stride)
 
 
 def check_programs(layout: Layout) -> tuple[ProgramCheck, ...]:
@@ -373,14 +461,15 @@ def _move_name(p: ProgramCheck, i: int) -> str:
 def program_lines(p: ProgramCheck) -> list[str]:
     whose = f"robot {p.robot}: " if p.robot else ""
     out = [f"{whose}{len(p.moves)} moves, cycle {p.cycle:.2f} s, tool {p.tool}; links tested against pedestals, "
-           f"tables, obstacles, fences and the floor at least every {DEPTH * 1000:.0f} mm of capsule travel "
+           f"tables, obstacles, fences and the floor at least every {p.spacing * 1000:.0f} mm of capsule travel "
            f"(capsule points at most {p.speed_bound:.2f} m/s)"]
     if p.kind == "row":
         worst = max(p.moves, key=lambda m: m.turn_deg)
-        fast = max(p.moves, key=lambda m: m.tool_speed)
+        fast = max((m for m in p.moves if not math.isnan(m.tool_speed)), key=lambda m: m.tool_speed)
+        every = f"; taken every {p.speed_stride} rows" if p.speed_stride > 1 else ""
         out.append(f"  {len(p.moves)} linear moves between the file's rows: largest joint travel "
                    f"{worst.joint or '-'} {worst.turn_deg:.1f} deg ({_move_name(p, worst.index)}), tool top speed "
-                   f"{fast.tool_speed:.2f} m/s ({_move_name(p, fast.index)})")
+                   f"{fast.tool_speed:.2f} m/s ({_move_name(p, fast.index)}{every})")
     else:
         for m in p.moves:
             slide = f", {m.slide_joint} {m.slide_m:.3f} m" if m.slide_joint else ""
