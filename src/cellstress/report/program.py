@@ -18,7 +18,8 @@ import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 
-from cellstress.analysis.program_check import ProgramCheck, capsule_axes, check_programs, robot_params, tool_frame
+from cellstress.analysis.program_check import ProgramCheck, check_programs, tool_frame
+from cellstress.analysis.program_sweep import capsule_axes, robot_params
 from cellstress.core.text import for_terminal
 from cellstress.report import draw as D
 from cellstress.sim import kernels as K
