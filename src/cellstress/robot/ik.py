@@ -25,7 +25,7 @@ import numpy as np
 from cellstress.core.errors import CellstressError
 from cellstress.robot.joints import JointMap, limit_violation
 from cellstress.robot.model import RobotModel, load_pinocchio
-from cellstress.robot.turns import turns_freely, unwound
+from cellstress.robot.turns import TURN, turns_freely, unwound
 
 POSITION_TOL = 1e-3  # m: a pose counts as reached within 1 mm ...
 ANGLE_TOL = np.deg2rad(1.0)  # ... and 1 deg
@@ -36,7 +36,6 @@ MAX_STEP = 0.5  # rad (or m) per iteration
 NULL_GAIN = 0.5
 STALL = 40  # iterations: a solve whose error fell by less than STALL_GAIN over this many has stalled
 STALL_GAIN = 0.01
-TURN = 2.0 * np.pi
 SAME = 1e-6  # rad (or m): solutions this close are one
 
 
