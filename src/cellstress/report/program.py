@@ -162,7 +162,7 @@ def program_figure(layout: Layout, checks: tuple[ProgramCheck, ...] | None = Non
     the program check's lines under them. Returns the figure."""
     checks = checks if checks is not None else check_programs(layout)
     fig = D.new_figure(options.size)
-    top = fig.add_axes((0.05, 0.36, 0.43, 0.58))
+    top = fig.add_axes((0.07, 0.36, 0.41, 0.58))
     side = fig.add_axes((0.54, 0.36, 0.43, 0.58))
     D.draw_plan(top, layout, D.PlanStyle(swept_area=False, robot_now=False, start=False))
     motions = [_motion(layout, r) for r in range(len(layout.robots))]
