@@ -17,8 +17,8 @@ def check(
     Exit code 0 if the static check passes, 1 if it fails (a gate for a design in CI), 2 for a file that is not
     a valid cell."""
     from cellstress.analysis.iso13855 import check_cell
-    from cellstress.analysis.robot_audit import audit_robot
     from cellstress.analysis.program_check import check_programs
+    from cellstress.analysis.robot_audit import audit_robot
     from cellstress.cell.load import BUILTIN_CELLS, builtin_file, load_cell
     from cellstress.robot.geometry import robot_geometry
     from cellstress.sim.build import build_layout
