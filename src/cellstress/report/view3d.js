@@ -16,7 +16,7 @@
   var legend = document.getElementById("cs3d-legend");
   var COL = {
     floor: "#ececec", fence: "#2b2b2b", pallet: "#a0785a", table: "#dcc9a0", obstacle: "#c9c3b8",
-    pedestal: "#9e9e9e", robot: "#6e6e6e", hit: "#d62728", body: "#1f77b4", touch: "#ff7f0e", reach: "#ff9f1c",
+    pedestal: "#9e9e9e", robot: "#6e6e6e", hit: "#d62728", body: "#1f77b4", touch: "#e8590c", reach: "#ffb347",
     path: "#1f77b4", start: "#2ca02c", contact: "#ff00ff"
   };
   var NA = 10, NL = 3, PER = 2 + 2 * NL * NA, FACES = 4 * NL * NA;  // capsule mesh: vertices, faces each
@@ -184,14 +184,14 @@
       [0, 1].forEach(function () {
         idx.reach.push(traces.length);
         traces.push({type: "scatter3d", mode: "markers", x: [], y: [], z: [], hoverinfo: "skip",
-                     marker: {size: 2, color: COL.reach, opacity: 0.35}});
+                     marker: {size: 2, color: COL.reach, opacity: 0.2}});
       });
     }
     if (ep.marker) {
       idx.marker = traces.length;
       traces.push({type: "scatter3d", mode: "lines+markers", x: [], y: [], z: [], hoverinfo: "skip",
                    line: {color: "#000000", width: 6},
-                   marker: {size: [9, 5], color: [COL.contact, COL.body], symbol: ["diamond", "circle"],
+                   marker: {size: [14, 7], color: [COL.contact, COL.body], symbol: ["diamond", "circle"],
                             line: {color: "#000000", width: 1}}});
     }
   }
@@ -269,7 +269,11 @@
     var work = Plotly.restyle(gd, {x: X, y: Y, z: Z}, ids)
       .then(function () { return Plotly.restyle(gd, colors, cids); });
     if (idx.reach.length) {
-      work = work.then(function () { return Plotly.restyle(gd, {"marker.color": reachColor}, idx.reach); });
+      work = work.then(function () {
+        return Plotly.restyle(gd, {"marker.color": reachColor, "marker.opacity": reachColor.map(function (c) {
+          return c === COL.touch ? 0.45 : 0.2;
+        })}, idx.reach);
+      });
     }
     if (idx.fields.length) {
       work = work.then(function () {
@@ -278,6 +282,7 @@
         })}, idx.fields);
       });
     }
+    root.csPending = work;  // the tests wait on it (and then on a frame) before a screenshot
     return work;
   }
 
@@ -336,7 +341,7 @@
     Object.keys(kinds).sort().forEach(function (k) { legendItem(COL[k], k + " (prism, its height)"); });
     CELL.fields.forEach(function (f, k) {
       var what = f.shape === "prism" ? "field up to its plane" : (f.shape === "door" ? "door leaf" : "vertical field");
-      legendItem(f.color, f.name + " (" + f.type + ", " + what + "; bright once it sees the worker)", k);
+      legendItem(f.color, f.name + " (" + f.type + ", " + what + (ep.body ? "; bright once it sees the worker)" : ")"), k);
     });
     legendItem(COL.start, "start points and headings");
   }

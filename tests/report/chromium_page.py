@@ -8,6 +8,7 @@ resolver that resolves nothing, so a request to any server fails and is recorded
 from __future__ import annotations
 
 import base64
+import fcntl
 import io
 import json
 import os
@@ -44,8 +45,10 @@ class Page:
         self._r, from_child_w = os.pipe()
 
         def fds():  # the child's fds 3 and 4 are the pipe's ends, as --remote-debugging-pipe expects
-            os.dup2(to_child_r, 3)
-            os.dup2(from_child_w, 4)
+            a = fcntl.fcntl(to_child_r, fcntl.F_DUPFD, 10)  # (first out of the way: either end may be 3 or 4)
+            b = fcntl.fcntl(from_child_w, fcntl.F_DUPFD, 10)
+            os.dup2(a, 3)
+            os.dup2(b, 4)
 
         self.proc = subprocess.Popen(
             [exe, "--headless", "--no-sandbox", "--remote-debugging-pipe", f"--user-data-dir={profile}",
@@ -53,7 +56,7 @@ class Page:
              "--disable-background-networking", "--disable-component-update", "--disable-sync",
              "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--proxy-server=127.0.0.1:9",
              "--host-resolver-rules=MAP * ~NOTFOUND", "about:blank"],
-            pass_fds=(to_child_r, from_child_w), preexec_fn=fds, stdout=subprocess.DEVNULL,
+            pass_fds=(3, 4, to_child_r, from_child_w), preexec_fn=fds, stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL)
         os.close(to_child_r)
         os.close(from_child_w)
@@ -134,7 +137,7 @@ class Page:
             time.sleep(0.2)
 
     def screenshot(self, clip: dict | None = None) -> np.ndarray:
-        params = {"format": "png"}
+        params = {"format": "png", "captureBeyondViewport": True}
         if clip is not None:
             params["clip"] = {**clip, "scale": 1}
         data = self.call("Page.captureScreenshot", **params)["data"]
