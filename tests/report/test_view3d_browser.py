@@ -8,7 +8,6 @@ import json
 
 import numpy as np
 import pytest
-
 from chromium_page import Page, need_chromium
 
 SETTLED = ("document.getElementById('cs3d').csPending.then(() => new Promise(r => "

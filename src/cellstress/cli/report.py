@@ -47,7 +47,7 @@ def show(
                                             "as a plain file name, .png, in the current folder; .html with "
                                             "--3d).")] = None,
     three_d: Annotated[bool, typer.Option("--3d", help="Write an interactive 3D view (one self-contained HTML "
-                                          "file) with the robot's program over one cycle, instead of the PNG.")] = False,
+                                          "file) with the robot's program over one cycle, not the PNG.")] = False,
 ) -> None:
     """Draw a cell's layout to scale (fences, table, devices, the robot's swept area, the start) as a PNG, or with
     --3d as an interactive 3D page."""

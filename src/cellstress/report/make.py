@@ -16,9 +16,9 @@ from cellstress.report import html as H
 from cellstress.report.animate import AnimationOptions, animate
 from cellstress.report.episode import EpisodeView, episode_of
 from cellstress.report.hazard import StillOptions, contact_figure, risk_figure, topview_figure
+from cellstress.report.scene3d import view_of_episodes, view_of_program
 from cellstress.report.scope import NOT_A_PROOF, judged_by, search_scope, strongest_contact
 from cellstress.report.story import Account, account
-from cellstress.report.scene3d import view_of_episodes, view_of_program
 from cellstress.report.view3d import STYLE as VIEW3D_STYLE
 from cellstress.report.view3d import view_fragment, view_page
 from cellstress.searchers.result import FILE_NAME, SearchResult
