@@ -602,6 +602,8 @@ NAMED: list[Case] = [
     Case("name-traversal-show", ("show", CELL), 0, cell=_set("name", "../../x"), creates=("x.png",),
          check=_slug_only),
     Case("name-absolute-show", ("show", CELL), 0, cell=_set("name", "/tmp/x"), creates=("tmp-x.png",)),
+    Case("device-name-script-show-3d", ("show", CELL, "--3d", "--out", "out/cell.html"), 0,
+         cell=_set("devices[0].name", SCRIPT), check=_no_raw(SCRIPT, "</script><script>", files=("out/cell.html",))),
     Case("description-escape-check", ("check", CELL), 0, cell=_set("description", "safe\x1b]0;owned\x07 cell"),
          check=_no_raw()),
     Case("campaign-runs-symlink-planted", ("campaign", "--cells", "baseline", "--searchers", "random", "--seeds",
@@ -642,6 +644,7 @@ OPTIONS: list[Case] = [
     Case("replay-hazard-index", ("replay", RESULT, "--hazard", "5"), 2, ("--hazard 5",), result=lambda d: None,
          group="replay-hazard-index"),
     Case("show-not-png", ("show", "baseline", "--out", "out/x.txt"), 2, (".png",)),
+    Case("show-3d-not-html", ("show", "baseline", "--3d", "--out", "out/x.png"), 2, (".html",)),
     Case("check-unknown-cell", ("check", "../../etc/passwd"), 2, ("passwd",)),
     # issue 29 (helper harden): workers bounded, nothing written through a link in --out, campaign.json checked
     Case("verify-workers-huge", ("verify", "baseline", "--workers", str(10**6), "--out", "out"), 2, ("--workers",)),

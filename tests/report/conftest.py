@@ -41,6 +41,13 @@ def s3_sim():
 
 
 @pytest.fixture(scope="session")
+def s3_witness_view(s3_sim):
+    from cellstress.report.episode import replay
+
+    return replay(s3_sim, witnesses()["s3-fence-gap"], episode=1)
+
+
+@pytest.fixture(scope="session")
 def s1_witness_view():
     from cellstress.report.episode import replay
     from cellstress.sim.simulator import Simulator

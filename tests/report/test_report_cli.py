@@ -63,11 +63,14 @@ def test_show(tmp_path, capsys, monkeypatch):
     assert code == 0, err
     assert out.strip() == f"wrote     {tmp_path / 'pics' / 's2.png'}"
     with Image.open(tmp_path / "pics" / "s2.png") as img:
-        assert img.size == StillOptions().layout.pixels
+        width, height = StillOptions().layout.pixels  # the height; the width is fitted to the cell (report/fit.py)
+        assert img.size[1] == height and 0.5 * width < img.size[0] < 1.6 * width
         assert float(np.asarray(img.convert("L"), float).std()) > 8.0
     monkeypatch.chdir(tmp_path)
     assert _run(["show", "baseline"], capsys)[0] == 0
     assert (tmp_path / "baseline.png").is_file()
+    assert _run(["show", "baseline", "--3d"], capsys)[0] == 0  # the 3D page, named after the cell
+    assert 'id="cs3d-data"' in (tmp_path / "baseline.html").read_text(encoding="utf-8")
 
 
 @pytest.mark.parametrize("args", [["show", "no-such-cell"], ["show", "baseline", "--out", "x.txt"]])

@@ -30,7 +30,10 @@ def _not_blank(img: Image.Image) -> float:
 def test_images_decode_with_size_and_content(s3_report, name):
     with Image.open(s3_report / name) as img:
         img.load()
-        assert img.size == SIZES[name]
+        if name == "topview.png":  # fitted to its content (report/fit.py): the height is the option's or more
+            assert img.size[1] >= SIZES[name][1] and 0.5 * SIZES[name][0] < img.size[0] < 1.6 * SIZES[name][0]
+        else:
+            assert img.size == SIZES[name]
         assert _not_blank(img) > MIN_STD
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import re
 
 import numpy as np
 import pytest
@@ -11,6 +12,7 @@ import pytest
 import cellstress
 from cellstress.cell.load import builtin_text, load_cell, with_criterion
 from cellstress.cli import main
+from cellstress.report.verify import MAX_WITNESS_VIEWS
 from cellstress.searchers.result import SearchResult
 from cellstress.sim.simulator import Simulator
 from cellstress.verifier.bounds import Bounds
@@ -63,7 +65,12 @@ def test_command_exit_codes_and_replayable_witnesses(tmp_path, capsys) -> None:
     assert main(["verify", "s1-scanner-width", "--phases", "cell", "--horizon", "5", "--out", str(out)]) == 1
     doc = json.loads((out / "verify.json").read_text())
     assert doc["verdict"] == "UNSAFE" and doc["hazardous"] > 0 and (out / "verify.png").is_file()
-    assert doc["classes"][0]["file"] in (out / "verify.html").read_text()
+    page = (out / "verify.html").read_text()
+    assert doc["classes"][0]["file"] in page
+    # every witness in the page's 3D view (report/verify.witness_view), each replayed to its contact
+    view = json.loads(re.search(r'id="cs3d-data">(.*?)</script>', page, flags=re.S).group(1))
+    assert len(view["episodes"]) == min(len(doc["classes"]), MAX_WITNESS_VIEWS)
+    assert all(ep["marker"]["kind"] == "contact" and ep["marker"]["step"] == ep["n"] - 1 for ep in view["episodes"])
     witness = out / doc["classes"][0]["file"]
     assert main(["replay", str(witness)]) == 0
     assert "REPRODUCED bit-exactly" in capsys.readouterr().out

@@ -44,30 +44,37 @@ def show(
     cell: Annotated[str, typer.Argument(help="A built-in cell name (see 'cellstress cells') or the path of a "
                                         "cell file.")],
     out: Annotated[str | None, typer.Option("--out", "-o", help="PNG file to write (default: the cell's name "
-                                            "as a plain file name, .png, in the current folder).")] = None,
+                                            "as a plain file name, .png, in the current folder; .html with "
+                                            "--3d).")] = None,
     program: Annotated[bool, typer.Option("--program", help="Draw the robot's program alone instead: its moves "
                                           "over one cycle from above and the side, with the program check.")] = False,
+    three_d: Annotated[bool, typer.Option("--3d", help="Write an interactive 3D view (one self-contained HTML "
+                                          "file) with the robot's program over one cycle, not the PNG.")] = False,
 ) -> None:
     """Draw a cell's layout to scale (fences, table, devices, the robot's swept area, the start) as a PNG; with
-    --program, the robot's program over one cycle (no worker)."""
+    --program, the robot's program over one cycle (no worker); with --3d, an interactive 3D page."""
     from cellstress.cell.load import load_cell
 
     try:
         c = load_cell(cell)
     except CellstressError as exc:
         raise fail(str(exc)) from None
-    default = f"{slug(c.spec.name)}-program.png" if program else f"{slug(c.spec.name)}.png"
+    if program and three_d:
+        raise fail("--program and --3d: choose one (the 3D view already plays the robot's program)")
+    ext = ".html" if three_d else ".png"
+    default = f"{slug(c.spec.name)}-program.png" if program else f"{slug(c.spec.name)}{ext}"
     path = Path(out) if out is not None else Path(default)
-    if path.suffix.lower() != ".png":
-        raise fail(f"--out {out}: the picture is a PNG file, give a name ending in .png")
-    from cellstress.report.make import show_cell
+    if path.suffix.lower() != ext:
+        raise fail(f"--out {out}: " + ("the 3D view is an HTML file, give a name ending in .html" if three_d else
+                                       "the picture is a PNG file, give a name ending in .png"))
+    from cellstress.report.make import show_cell, show_cell_3d
     from cellstress.report.program import show_program
 
     try:
         if path.parent != Path(""):
             path.parent.mkdir(parents=True, exist_ok=True)
         with spinner_while_compiling():
-            (show_program if program else show_cell)(c, path)
+            (show_cell_3d if three_d else show_program if program else show_cell)(c, path)
     except CellstressError as exc:
         raise fail(str(exc)) from None
     except OSError as exc:

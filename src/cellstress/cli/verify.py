@@ -48,7 +48,7 @@ def verify(
     from cellstress.cell.load import load_cell, with_criterion
     from cellstress.core.cpus import check_workers, usable_cpus
     from cellstress.report.scope import judged_by
-    from cellstress.report.verify import HTML_NAME, PNG_NAME, hazard_map, summary_lines, verify_page
+    from cellstress.report.verify import HTML_NAME, PNG_NAME, hazard_map, summary_lines, verify_page, witness_view
     from cellstress.sim.simulator import Simulator
     from cellstress.verifier.run import verify_cell
 
@@ -77,7 +77,7 @@ def verify(
         raise typer.Exit(INTERRUPTED) from None
     elapsed = time.perf_counter() - t0
     png = hazard_map(res, out_dir / PNG_NAME)
-    page = verify_page(res, png, out_dir / HTML_NAME, judged_by(sim.criterion))
+    page = verify_page(res, png, out_dir / HTML_NAME, judged_by(sim.criterion), witness_view(res, sim))
     for line in summary_lines(res, judged_by(sim.criterion), str(out_dir)):
         say(line)
     say(f"wrote     {out_dir / 'verify.json'}, {png.name}, {page.name} ({elapsed:.1f} s)")

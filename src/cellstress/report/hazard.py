@@ -16,6 +16,7 @@ from cellstress.analysis.iso13855 import StaticCheck
 from cellstress.core import plane
 from cellstress.report import draw as D
 from cellstress.report.episode import EpisodeView
+from cellstress.report.fit import fit_plan
 from cellstress.sim.build import Layout
 
 POSTURE_MARK = {"upright": "U", "bend-forward": "F", "bend-left": "L", "bend-right": "R",
@@ -34,12 +35,7 @@ class StillOptions:
     layout: D.FigureSize = D.FigureSize(11.0, 8.5, 100)
 
 
-PLAN_AXES = (0.06, 0.07, 0.56, 0.86)  # left, bottom, width, height: room for the legend on the right
-
-
-def _legend(fig, ax, handles) -> None:
-    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.03, 1.0), fontsize=8, frameon=False,
-              borderaxespad=0.0)
+PLAN_AXES = (0.06, 0.07, 0.56, 0.86)  # where a plan starts; fit.fit_plan then sizes the figure to it
 
 
 def layout_figure(layout: Layout, size: D.FigureSize = StillOptions().layout, title: str | None = None,
@@ -54,7 +50,7 @@ def layout_figure(layout: Layout, size: D.FigureSize = StillOptions().layout, ti
     if static is not None:
         handles += _draw_distances(ax, static)
     ax.set_title(title or f"{spec.name}: cell layout (top view, metres)", fontsize=11, loc="left")
-    _legend(fig, ax, handles)
+    fit_plan(fig, ax, handles, size.height)
     return fig, ax
 
 
@@ -150,7 +146,7 @@ def _draw_episode(ax, view: EpisodeView, pose, reach: list[np.ndarray], handles:
                label=f"{label} (t = {hit.t:.2f} s)"))
 
 
-INSET_AXES = (0.66, 0.07, 0.32, 0.42)  # below the legend
+INSET_AXES = (0.66, 0.07, 0.32, 0.42)  # a first place; fit.fit_plan puts it under the legend
 
 
 def topview_figure(view: EpisodeView, size: D.FigureSize = StillOptions().topview, title: str | None = None,
@@ -170,7 +166,6 @@ def topview_figure(view: EpisodeView, size: D.FigureSize = StillOptions().topvie
     spec = view.layout.cell.spec
     what = "hazard" if view.unsafe else "no hazard; riskiest episode"
     ax.set_title(title or f"{spec.name}: {what} (episode {view.episode}), top view", fontsize=11, loc="left")
-    _legend(fig, ax, handles)
     # the enlarged view: the path, the touching reach volume and the contact, with a margin
     inset = fig.add_axes(INSET_AXES)
     D.draw_plan(inset, view.layout, D.PlanStyle(start_size=0.12), robot_tau=view.taus[key], zone=zone)
@@ -188,6 +183,7 @@ def topview_figure(view: EpisodeView, size: D.FigureSize = StillOptions().topvie
     inset.tick_params(labelsize=7)
     inset.set_xlabel("")
     inset.set_ylabel("")
+    fit_plan(fig, ax, handles, size.height, inset=inset)
     return fig, ax
 
 

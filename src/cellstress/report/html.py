@@ -1,5 +1,6 @@
-"""Self-contained HTML pages: images embedded as data URIs, styles inline, no script and no external URL, so
-a report can be mailed, archived or opened offline and shows the same thing everywhere.
+"""Self-contained HTML pages: images embedded as data URIs, styles and scripts inline (the 3D view,
+``report/view3d``), no external URL, so a report can be mailed, archived or opened offline and shows the same
+thing everywhere.
 """
 
 from __future__ import annotations
@@ -59,7 +60,7 @@ def table(header: list[str] | None, rows: list[list], numeric: set[int] | None =
     return "\n".join(out)
 
 
-def page(title: str, body: list[str], footer: str) -> str:
+def page(title: str, body: list[str], footer: str, extra_style: str = "") -> str:
     return "\n".join([
         "<!DOCTYPE html>",
         '<html lang="en">',
@@ -67,7 +68,7 @@ def page(title: str, body: list[str], footer: str) -> str:
         '<meta charset="utf-8">',
         '<meta name="viewport" content="width=device-width, initial-scale=1">',
         f"<title>{escape(title)}</title>",
-        f"<style>{STYLE}</style>",
+        f"<style>{STYLE}{extra_style}</style>",
         "</head>",
         "<body>",
         *body,

@@ -17,8 +17,11 @@ from cellstress.report.animate import AnimationOptions, animate
 from cellstress.report.episode import EpisodeView, episode_of
 from cellstress.report.hazard import StillOptions, contact_figure, risk_figure, topview_figure
 from cellstress.report.program import program_figure
+from cellstress.report.scene3d import view_of_episodes, view_of_program
 from cellstress.report.scope import NOT_A_PROOF, judged_by, search_scope, strongest_contact
 from cellstress.report.story import Account, account
+from cellstress.report.view3d import STYLE as VIEW3D_STYLE
+from cellstress.report.view3d import view_fragment, view_page
 from cellstress.searchers.result import FILE_NAME, SearchResult
 
 NAMES = ("topview.png", "contact.png", "replay.gif", "risk.png", "program.png", "report.html")
@@ -32,6 +35,7 @@ class ReportError(CellstressError):
 class ReportOptions:
     stills: StillOptions = field(default_factory=StillOptions)
     animation: AnimationOptions = field(default_factory=AnimationOptions)
+    view3d: bool = True  # report.html holds the interactive 3D view (plotly.js inline, about 5 MB)
 
 
 @dataclass(frozen=True)
@@ -102,9 +106,14 @@ def write_report(result: SearchResult | str | Path, out_dir: str | Path | None =
     why = None if not res.found or res.hazard.why is None else shortfall(res.hazard.why, check_cell(sim.cell))
     page = hazard_page(res, view, acc, top, contact, gif, risk, changed, Judgement(
         judged_by(sim.criterion), search_scope(res, sim.cell.spec, sim.layout.trajectory.cycle), strongest, why),
-        program)
+        program, view3d=_view3d(view) if options.view3d else "")
     html = H.write_page(out / NAMES[5], page)
     return ReportFiles(top, contact, gif, risk, program, html, acc, res.found, changed)
+
+
+def _view3d(view: EpisodeView) -> str:
+    what = "hazard" if view.kind == "hazard" else "riskiest kept episode"
+    return view_fragment(view_of_episodes(view.layout, [(view, f"episode {view.episode} ({what})")]))
 
 
 def _fmt(x, nd: int = 3) -> str:
@@ -140,7 +149,8 @@ class Judgement:
 
 
 def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, contact: Path, gif: Path,
-                risk: Path, cell_changed: bool, judgement: Judgement, program: Path | None = None) -> str:
+                risk: Path, cell_changed: bool, judgement: Judgement, program: Path | None = None,
+                view3d: str = "") -> str:
     cell = res.cell.name
     e = H.escape
     body = [f"<h1>cellstress report: {e(cell)}</h1>"]
@@ -172,6 +182,15 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
     body.append("<h2>What happens</h2>")
     body.append(f"<p><b>{H.escape(acc.headline)}</b></p>")
     body.append("<ol>" + "".join(f"<li>{H.escape(d)}</li>" for d in acc.details) + "</ol>")
+    if view3d:
+        key = view.key_row
+        word = "hazard's" if view.unsafe else "closest call's"
+        body.append("<h2>In 3D</h2>")
+        body.append(f"<p>The episode replayed step by step ({view.dt:g} s each): the robot's collision capsules, the "
+                    "worker's body capsules and reach volumes, the cell's fences, solids and detection fields; a "
+                    f"device's field turns bright from the step it sees the worker. Move the slider to step {key} "
+                    f"(the {word} step) to see the touching parts and the closest points.</p>")
+        body.append(view3d)
     body.append("<h2>Pictures</h2>")
     body.append(H.figure(top, "Top view of the cell to scale: the worker's path with a heading and posture mark "
                          "after each action, the robot and the worker at the key step, the arms' reach volumes, "
@@ -223,7 +242,8 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
                         row_classes=["unsafe" if r.unsafe else "" for r in view.records]))
     body.append("</details>")
     return H.page(f"cellstress report: {cell}", body, f"Made by cellstress {res.version} from {FILE_NAME} "
-                  f"(searcher {res.searcher}, seed {res.seed}). Replay: cellstress replay {FILE_NAME}")
+                  f"(searcher {res.searcher}, seed {res.seed}). Replay: cellstress replay {FILE_NAME}",
+                  extra_style=VIEW3D_STYLE if view3d else "")
 
 
 @D.plain_text
@@ -237,3 +257,21 @@ def show_cell(cell, out: str | Path, size: D.FigureSize | None = None) -> Path:
     layout = build_layout(c)
     fig, _ = layout_figure(layout, size or StillOptions().layout, static=check_cell(c, layout))
     return D.save_png(fig, out)
+
+
+def show_cell_3d(cell, out: str | Path) -> Path:
+    """``cellstress show --3d``: the cell in 3D with its robots' program animated over one cycle (no worker) and
+    the start points, as one self-contained HTML page."""
+    from cellstress.cell.load import load_cell
+    from cellstress.core.version import __version__
+    from cellstress.sim.build import build_layout
+
+    c = cell if not isinstance(cell, (str, Path)) else load_cell(cell)
+    layout = build_layout(c)
+    cycle = layout.trajectory.cycle
+    intro = [f"<p>The cell <b>{H.escape(c.spec.name)}</b> to scale: fences with their bottom and top, solids, "
+             "detection fields and the start points (green arrows), with the robot's program over one cycle "
+             f"({cycle:g} s, from the cell's phase; the slider moves through it). No worker: this is the layout "
+             "a search starts from.</p>"]
+    return view_page(out, f"{c.spec.name}: the cell in 3D", intro, view_of_program(layout),
+                     f"Made by cellstress {__version__} from {c.source}.")

@@ -12,6 +12,10 @@ from matplotlib.ticker import FuncFormatter, NullFormatter
 
 from cellstress.report import draw as D
 from cellstress.report import html as H
+from cellstress.report.episode import replay
+from cellstress.report.scene3d import view_of_episodes
+from cellstress.report.view3d import STYLE as VIEW3D_STYLE
+from cellstress.report.view3d import view_fragment
 from cellstress.verifier.records import PROVED_SAFE, UNDECIDED, UNSAFE, VerifyResult
 
 PNG_NAME = "verify.png"
@@ -20,6 +24,7 @@ MAP_SIZE = D.FigureSize(9.0, 3.6, 100)
 SAFE_COLOUR = "#d9f0d3"
 UNDECIDED_COLOUR = "#bdbdbd"
 MAX_LISTED = 12  # hazardous sub-trees listed one by one in the summary
+MAX_WITNESS_VIEWS = 24  # witnesses offered in verify.html's 3D view (each about 0.1-0.3 MB); all are in files
 
 
 @D.plain_text
@@ -134,9 +139,22 @@ def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None
     return lines
 
 
-def verify_page(res: VerifyResult, png: str | Path, path: str | Path, criterion_text: str) -> Path:
+def witness_view(res: VerifyResult, sim) -> str:
+    """The 3D view of the first ``MAX_WITNESS_VIEWS`` witnesses, replayed in ``sim`` (one to pick at a time);
+    empty without a witness."""
+    if not res.classes:
+        return ""
+    views = []
+    for i, w in enumerate(res.classes[:MAX_WITNESS_VIEWS], start=1):
+        view = replay(sim, list(w.actions), episode=1)
+        views.append((view, f"class {i}: {w.klass.robot_link} / {w.klass.body_region} ({w.klass.device})"))
+    return view_fragment(view_of_episodes(views[0][0].layout, views), episode_labels=True)
+
+
+def verify_page(res: VerifyResult, png: str | Path, path: str | Path, criterion_text: str, view3d: str = "") -> Path:
     """``verify.html``: the verdict, the proof's size, the hazard map, the hazardous sub-trees and each hazard
-    class with its witness (self-contained, like every report page)."""
+    class with its witness (self-contained, like every report page); ``view3d`` (``witness_view``) shows each
+    witness in 3D."""
     lines = summary_lines(res, criterion_text)
     verdict = next(ln for ln in lines if ln.startswith(res.verdict))
     body = [f"<h1>{escape(res.cell.name)}: {escape(res.verdict)}</h1>",
@@ -161,5 +179,12 @@ def verify_page(res: VerifyResult, png: str | Path, path: str | Path, criterion_
                          [[i, w.klass.device, f"{w.klass.robot_link} / {w.klass.body_region}", f"{w.sequences:,}",
                            ", ".join(w.actions), w.file] for i, w in enumerate(res.classes, start=1)],
                          numeric={0, 3})]
+    if view3d:
+        shown = min(len(res.classes), MAX_WITNESS_VIEWS)
+        body += ["<h2>Witnesses in 3D</h2>",
+                 f"<p>Each witness replayed (pick one; {shown} of {len(res.classes)} classes shown): the robot's "
+                 "capsules, the worker's body and reach volumes, the fences, solids and detection fields. The "
+                 "slider's last step is the contact.</p>", view3d]
     return H.write_page(path, H.page(f"verify {res.cell.name}", body,
-                                     f"cellstress {res.version}; replay a witness with: cellstress replay FILE"))
+                                     f"cellstress {res.version}; replay a witness with: cellstress replay FILE",
+                                     extra_style=VIEW3D_STYLE if view3d else ""))
