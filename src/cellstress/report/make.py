@@ -194,8 +194,8 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
         ["episode shown", f"{view.episode} ({'first hazard' if view.kind == 'hazard' else 'riskiest kept'})"],
         ["simulation", f"dt {spec.simulation.dt:g} s, {spec.simulation.steps_per_action} steps per action, "
                        f"{spec.simulation.actions_per_episode} actions per episode"],
-        ["robot stopping time", f"{spec.robot.stopping_time:g} s" if len(spec.robots) == 1 else
-         ", ".join(f"{r.name} {r.stopping_time:g} s" for r in spec.robots)],
+        ["robot stopping time", view.layout.robots[0].stop.describe() if len(spec.robots) == 1 else
+         ", ".join(f"{p.name} {p.stop.describe()}" for p in view.layout.robots)],
         ["devices", "; ".join(f"{d.name} ({d.type}, response {d.response_time:g} s)" for d in spec.devices) or "-"],
         ["replay", "agrees bit-exactly with result.json" if view.matches_file else
          ("no trace in result.json (riskiest episode replayed)" if view.matches_file is None else "DIFFERS")],

@@ -82,7 +82,8 @@ class DeviceTiming(Record):
     saw_at_s: float | None
     """First time the device saw the worker [s]; None: never, up to the contact."""
     stop_at_s: float | None
-    """When the stop it asked for took effect (saw_at_s plus its response time) [s]."""
+    """When the stop it asked for took effect (saw_at_s plus its response time): its signal reached the robot [s].
+    The robot begins to brake after its controller's delay (``Why.braking_from_s``)."""
 
 
 class Why(Record):

@@ -211,7 +211,8 @@ PHASE_RUNNING, PHASE_PENDING, PHASE_BRAKING, PHASE_STOPPED, PHASE_REDUCED = PHAS
 
 SCALARS = VectorSpec("scalar parameters (SimParams.scal)", (
     ("DT", "time step [s]"),
-    ("STOP_TIME", "robot's stopping time: from full speed to standstill [s]"),
+    ("STOP_TIME", "robot's braking time: from full speed, once it begins to brake (STOP_DELAY after its stop's "
+                  "signal), to standstill [s]"),
     ("PHASE0", "robot's path time when an episode starts [s]"),
     ("CYCLE", "robot's cycle time [s]"),
     ("LINEAR", "1: the robot's moves are at constant speed (a trajectory file); 0: minimum-jerk"),
@@ -219,9 +220,17 @@ SCALARS = VectorSpec("scalar parameters (SimParams.scal)", (
     ("VTOL", "robot speed above which a contact is unsafe [m/s]; inf: the kernel judges no contact"),
     ("REACH_ORIGIN", "reach field: coordinate of its first grid node on every axis [m]"),
     ("REACH_H", "reach field: grid spacing [m]"),
+    # how the robot stops (issue 28; appended, so the slots above never move)
+    ("STOP_DELAY", "time from a stop's signal (detection plus the device's response) until the robot begins to brake "
+                   "[s]: the controller's delay; the latched stop (TSTOP) takes effect after it. 0 for category 0"),
+    ("STOP_HOLD", "1: a category 0 stop: from the moment it takes effect the robot is posed where it was, its "
+                  "capsules grown for the joints' independent braking (sim.build) and its speed falling to 0 "
+                  "within STOP_TIME; 0: it brakes along its path"),
 ))
-(C_DT, C_STOP_TIME, C_PHASE0, C_CYCLE, C_LINEAR, C_DTOL, C_VTOL, C_REACH_ORIGIN, C_REACH_H) = SCALARS.indices(
-    "DT", "STOP_TIME", "PHASE0", "CYCLE", "LINEAR", "DTOL", "VTOL", "REACH_ORIGIN", "REACH_H")
+(C_DT, C_STOP_TIME, C_PHASE0, C_CYCLE, C_LINEAR, C_DTOL, C_VTOL, C_REACH_ORIGIN, C_REACH_H,
+ C_STOP_DELAY, C_STOP_HOLD) = SCALARS.indices(
+    "DT", "STOP_TIME", "PHASE0", "CYCLE", "LINEAR", "DTOL", "VTOL", "REACH_ORIGIN", "REACH_H",
+    "STOP_DELAY", "STOP_HOLD")
 N_SCAL = SCALARS.size
 
 DEVICE_KINDS = VectorSpec("detection primitive kinds (SimParams.dev_kind)", (
