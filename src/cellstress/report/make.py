@@ -18,6 +18,7 @@ from cellstress.report.hazard import StillOptions, contact_figure, risk_figure, 
 from cellstress.report.scope import NOT_A_PROOF, judged_by, search_scope, strongest_contact
 from cellstress.report.story import Account, account
 from cellstress.searchers.result import FILE_NAME, SearchResult
+from cellstress.searchers.severity import words as severity_words
 
 NAMES = ("topview.png", "contact.png", "replay.gif", "risk.png", "report.html")
 
@@ -143,6 +144,9 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
         verdict = (f"<b>Hazard found</b> at episode {h.episode} of {res.budget} ({e(res.searcher)}, seed "
                    f"{res.seed}): {e(str(h.robot_link))} / {e(str(h.body_part))} at t = {h.time_s:.2f} s, "
                    f"v_R = {h.v_R:.2f} m/s.")
+        sev = h.severity
+        if sev is not None and (sev.creeping or sev.force_ratio is not None):  # (v_R is its speed, shown above)
+            verdict += f" Severity: {e(severity_words(sev))}."
         if h.verdict is not None:
             name, numbers = h.verdict
             verdict += f" {e(name)}: {e(str(numbers.get('reason')))}."
