@@ -223,3 +223,26 @@ def test_grown_capsules_hold_every_pose_within_the_joints_travel(ur5):
             assert np.all(moved <= grow + 1e-9)
             worst = max(worst, float((moved / np.maximum(grow, 1e-12)).max()))
     assert worst > 0.3  # the bound is not vacuous: some poses use a good part of it
+
+
+def test_the_docs_example_reads_as_documented(tmp_path, ur5):
+    """docs/robot.md's stopping block and data file: valid, and the UR5's category 0 rows (its manual's) stop
+    faster than a linear ramp from the signal, as the page says."""
+    import re
+    from pathlib import Path
+
+    import yaml
+
+    from cellstress.cell.stopping import StoppingSpec
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "robot.md").read_text(encoding="utf-8")
+    section = text[text.index("## Stopping"):]
+    block = yaml.safe_load(re.search(r"```yaml\n(.*?)```", section, re.S)[1])
+    spec = StoppingSpec.model_validate(block["robot"]["stopping"], strict=True)
+    assert spec.category == 1 and spec.data == "ur5-stopping.csv"
+    rows = read_stopping_file(write(tmp_path, re.search(r"```csv\n(.*?)```", section, re.S)[1]))
+    for r in rows:
+        if r.category == 0:
+            v = float(ur5.velocity_limits[ur5.joint_names.index(r.joint)])
+            assert 0.40 <= r.distance / v / r.time <= 0.43
+            assert profile(r.distance, r.time, v).reading == FASTER
