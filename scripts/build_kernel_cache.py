@@ -4,8 +4,9 @@
 
 Runs the commands below in fresh interpreters with an empty NUMBA_CACHE_DIR, numba's CPU set to the x86-64-v2
 level and the shipped cache switched off, so numba compiles every kernel a user's commands reach and writes its
-cache files there; then packs them with a manifest (numba version, Python, and the sha256 of every source file each
-compiled module imports within cellstress, transitively: a kernel's code can depend on nothing else). Run it
+cache files there; then packs them with a manifest (numba version, Python, the sha256 of every source file each
+compiled module imports within cellstress, transitively: a kernel's code can depend on nothing else, and the sha256
+of every cache file packed, which a cached copy is compared with before numba may read it). Run it
 after changing any compiled module or what it imports; tests/core/test_jit.py fails until then. ``--check``
 only says whether the archive is current (exit 1 if not). See cellstress.core.jit for how it is used.
 """
@@ -168,6 +169,8 @@ def pack(cache: Path) -> dict:
             manifest["closures"][rel_source] = deps
             for rel in deps:
                 manifest["sources"][rel] = hashlib.sha256((PACKAGE / rel).read_bytes()).hexdigest()
+    # each entry's sha256: jit.seed compares a file already in a cache folder with it, and never unpickles one
+    manifest["files"] = {member: hashlib.sha256(files[member].read_bytes()).hexdigest() for member in sorted(files)}
     tmp = ARCHIVE.with_suffix(".tmp")
     with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=9) as z:
         z.writestr("manifest.json", json.dumps(manifest, indent=1, sort_keys=True))

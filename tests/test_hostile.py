@@ -190,6 +190,70 @@ _ENTITY_BOMB = (b'<?xml version="1.0"?><!DOCTYPE r [<!ENTITY a "aaaaaaaaaa">'
                 + b"".join(f'<!ENTITY {chr(98 + i)} "{("&" + chr(97 + i) + ";") * 10}">'.encode() for i in range(8))
                 + b']><robot name="r"><link name="&i;"/></robot>')
 
+# ---- issue 29 (helper harden): helpers for the second round's inputs ------------------------------------------
+SECRET = b"root:x:0:0:SECRET-TOKEN-29:/root:/bin/bash\ndaemon:x:1:1:daemon:/usr/sbin:/usr/sbin/nologin\n"
+
+
+def _device(kind: str, **change) -> Callable[[dict], None]:
+    """A change of the first device of type ``kind``."""
+
+    def apply(cell: dict) -> None:
+        next(d for d in cell["devices"] if d["type"] == kind).update(change)
+
+    return apply
+
+
+def _warning_field(scale: float, dx: float = 0.0) -> Callable[[dict], None]:
+    """A warning field made from the protective field, scaled about the origin and shifted along x."""
+
+    def apply(cell: dict) -> None:
+        scanner = next(d for d in cell["devices"] if d["type"] == "laser-scanner")
+        scanner["warning"] = {"polygon": [[x * scale + dx, y * scale] for x, y in scanner["polygon"]]}
+
+    return apply
+
+
+def _in_home(name: str, data: bytes) -> Callable[[Path], None]:
+    """A file in the HOME the child processes get (the corpus's root/home), for ``~/`` paths."""
+
+    def setup(folder: Path) -> None:
+        home = folder.parents[1] / "home"
+        home.mkdir(parents=True, exist_ok=True)
+        (home / name).write_bytes(data)
+
+    return setup
+
+
+def _quotes_nothing(*secrets: str) -> Callable[[Path, str, str], None]:
+    def check(folder: Path, out: str, err: str) -> None:
+        for w in secrets:
+            assert w not in out + err, f"{w!r} quoted: {err[-500:]}"
+
+    return check
+
+
+def _manifest(**change) -> bytes:
+    """A campaign.json of the right types (for the corpus's campaign command on baseline), then changed."""
+    doc = {"format": 1, "cellstress_version": "0", "cells": [{"name": "baseline", "source": "baseline",
+                                                             "sha256": "0" * 64}],
+           "searchers": [{"name": "random", "params": {}}], "seeds": [0], "budget": 2, "until": "first", "runs": 1}
+    doc.update(change)
+    return json.dumps(doc).encode()
+
+
+def _twice(key: str, value: object) -> Callable[[dict], None]:
+    """A change that makes ``params`` hold ``key`` twice: an int key and a text key are both written as "key"."""
+
+    def apply(doc: dict) -> None:
+        doc["params"] = {int(key): value, key: value}
+
+    return apply
+
+
+def _risks(n: int) -> Callable[[dict], None]:
+    return _set("risk_per_episode", [0.25] * n)
+
+
 # ---- cell files that must be refused (exit 2), by every command that reads a cell ---------------------------
 BAD_CELLS: list[tuple[str, dict, tuple[str, ...]]] = [
     ("fifo", {"setup": _fifo(CELL)}, ("cell.yaml", "not a regular file")),
@@ -280,6 +344,34 @@ BAD_CELLS: list[tuple[str, dict, tuple[str, ...]]] = [
      ("robot.stopping.data", "shoulder_pan_joint", "never extrapolated")),
     ("python-tag", {"cell_bytes": b"!!python/object/apply:os.system ['touch pwned']\n"}, ("cell.yaml",)),
     ("list-at-top", {"cell_bytes": b"- a\n- b\n"}, ("cell.yaml",)),
+    # issue 29 (helper harden): rows counted whatever ends them, other files never quoted, clock windows, fields
+    ("csv-200001-rows-no-final-newline", {"cell": _task(trajectory_csv="q.csv"), "setup": _write(
+        "in/q.csv", _CSV_HEAD + b"0,0,0,0,0,0,0\n" * 199_999 + b"0,0,0,0,0,0,0")}, ("trajectory_csv", "200,000 rows")),
+    ("csv-rows-end-in-cr", {"cell": _task(trajectory_csv="q.csv"), "setup": _write(
+        "in/q.csv", (_CSV_HEAD + b"0,0,0,0,0,0,0\n" * 250_000).replace(b"\n", b"\r"))},
+     ("trajectory_csv", "200,000 rows")),
+    ("csv-etc-passwd", {"cell": _task(trajectory_csv="/etc/passwd"), "check": _quotes_nothing("root:x", "bash")},
+     ("trajectory_csv", "/etc/passwd", "row 1", "header must be")),
+    ("csv-secret-in-home", {"cell": _task(trajectory_csv="~/secret.csv"), "setup": _in_home("secret.csv", SECRET),
+                            "check": _quotes_nothing("SECRET", "root:x")}, ("trajectory_csv", "secret.csv", "row 1")),
+    ("csv-secret-in-header", {"cell": _task(trajectory_csv="q.csv"), "setup": _write(
+        "in/q.csv", b"time,q1,q2,q3,q4,q5,SECRET-TOKEN-29\n0,1.4,-0.8,1.3,-2.1,-1.57,0\n"),
+        "check": _quotes_nothing("SECRET")}, ("trajectory_csv", "column 7 should be q6")),
+    ("csv-secret-in-a-value", {"cell": _task(trajectory_csv="q.csv"), "setup": _write(
+        "in/q.csv", _CSV_HEAD + b"1,1.4,-0.8,SECRET-TOKEN-29,-2.1,-1.57,0\n"), "check": _quotes_nothing("SECRET")},
+     ("trajectory_csv", "row 3, column 4", "not a number")),
+    ("csv-huge-value", {"cell": _task(trajectory_csv="q.csv"), "setup": _write(
+        "in/q.csv", _CSV_HEAD + b"1,1.4,-0.8,123456789012345678,-2.1,-1.57,0\n"),
+        "check": _quotes_nothing("123456789012345678")}, ("trajectory_csv", "row 3, column 4", "sensible size")),
+    ("muting-500-s", {"cell": _device("light-curtain", muting={"pallet": [0.0, 2.0], "until": 500.0})},
+     ("muting", "lasts 500 s", "longer than the robot's cycle")),
+    ("muting-wraps-past-a-cycle", {"cell": _device("light-curtain", muting={"pallet": [5.0, 5.5], "until": 12.0})},
+     ("muting", "lasts 7 s", "longer than the robot's cycle")),
+    ("muting-after-the-cycle", {"cell": _device("light-curtain", muting={"pallet": [30.0, 31.0], "until": 31.0})},
+     ("muting", "starts at 30 s", "after the robot's cycle")),
+    ("warning-field-inside", {"cell": _warning_field(0.5)}, ("devices", "warning.polygon must contain")),
+    ("warning-field-apart", {"cell": _warning_field(1.0, dx=20.0)}, ("devices", "warning.polygon must contain")),
+    ("warning-field-overlapping", {"cell": _warning_field(1.0, dx=0.3)}, ("devices", "warning.polygon must contain")),
 ]
 
 
@@ -445,6 +537,20 @@ BAD_RESULTS: list[tuple[str, dict, tuple[str, ...]]] = [
     ("severity-text", {"result": _set("hazard.severity.v_R", "fast")}, ("hazard.severity.v_R",)),
     ("severity-negative", {"result": _set("hazard.severity.v_R", -1.0)}, ("hazard.severity.v_R",)),
     ("severity-creeping-text", {"result": _set("hazard.severity.creeping", "no")}, ("hazard.severity.creeping",)),
+    # issue 29 (helper harden): lists that disagree with the episodes, keys given twice, the files a cell read
+    ("risks-600000", {"result": _risks(600_000)}, ("risk_per_episode", "600,000 values")),
+    ("risks-one-short", {"result": lambda d: d.update(risk_per_episode=d["risk_per_episode"][:-1])},
+     ("risk_per_episode",)),
+    ("episodes-over-budget", {"result": lambda d: d.update(episodes=d["budget"] + 1)}, ("episodes", "budget")),
+    ("hazard-list-beyond", {"result": _set("hazards[0].episode", 10**6)}, ("hazards[0].episode",)),
+    ("top-list-too-long", {"result": lambda d: d.update(top=d["top"] * 1000)}, ("top",)),
+    ("distinct-sequences-over", {"result": _set("distinct_sequences", 10**6)}, ("distinct_sequences",)),
+    ("key-twice-in-params", {"result": _twice("7", 0.5)}, ("result.json", "'7' appears twice")),
+    ("files-20000", {"result": lambda d: d["cell"].update(files=d["cell"]["files"] * 2000)}, ("cell.files",)),
+    ("files-path-escape", {"result": _set("cell.files[1].path", "a\x1b[2Jb")}, ("cell.files[1].path",)),
+    ("files-sha-not-hex", {"result": _set("cell.files[1].sha256", "z" * 64)}, ("cell.files[1].sha256",)),
+    ("files-bytes-text", {"result": _set("cell.files[1].bytes", "many")}, ("cell.files[1].bytes",)),
+    ("files-entry-text", {"result": _set("cell.files", ["/etc/passwd"])}, ("cell.files[0]",)),
 ]
 
 FORGED: list[tuple[str, Callable[[dict], None], str]] = [
@@ -462,6 +568,11 @@ FORGED: list[tuple[str, Callable[[dict], None], str]] = [
     ("severity-milder", _set("hazard.severity.v_R", 0.001), "hazard.severity.v_R"),
     ("severity-creeping", _set("hazard.severity.creeping", True), "hazard.severity.creeping"),
     ("searcher-unknown", _set("searcher", "<script>alert(1)</script>"), "searcher"),
+    # issue 29 (helper harden): replay names the file that differs
+    ("file-hash", _set("cell.files[1].sha256", "0" * 64), "cell.files"),
+    ("file-missing", lambda d: d["cell"].update(files=d["cell"]["files"][:-1]), "cell.files"),
+    ("file-extra", lambda d: d["cell"]["files"].append(dict(d["cell"]["files"][1], path="/elsewhere/x.stl")),
+     "cell.files"),
 ]
 
 
@@ -564,6 +675,33 @@ OPTIONS: list[Case] = [
          group="replay-hazard-index"),
     Case("show-not-png", ("show", "baseline", "--out", "out/x.txt"), 2, (".png",)),
     Case("check-unknown-cell", ("check", "../../etc/passwd"), 2, ("passwd",)),
+    # issue 29 (helper harden): workers bounded, nothing written through a link in --out, campaign.json checked
+    Case("verify-workers-huge", ("verify", "baseline", "--workers", str(10**6), "--out", "out"), 2, ("--workers",)),
+    Case("verify-workers-zero", ("verify", "baseline", "--workers", "0", "--out", "out"), 2, ("--workers",)),
+    Case("search-set-key-twice", ("search", "baseline", "-s", "evolve", "--set", 'pool={"a": 1, "a": 2}', "--out",
+                                  "out"), 2, ("--set pool", "'a' appears twice")),
+    *(Case(f"verify-witness-{kind}-planted", ("verify", "s1-scanner-width", "--phases", "cell", "--horizon", "4",
+                                             "--workers", "1", "--out", "out"), 2, ("witness-01", says),
+           setup=setup, group=f"verify-witness-{kind}")
+      for kind, setup, says in (("link", _link("out/witness-01", "../in"), "is a symbolic link"),
+                                ("file", _write("out/witness-01", b"mine\n"), "is not a folder"),
+                                ("dangling-link", _link("out/witness-01", "../nowhere"), "is a symbolic link"))),
+    *(Case(f"campaign-manifest-{name}", ("campaign", "--cells", "baseline", "--searchers", "random", "--seeds", "1",
+                                        "--budget", "2", "--workers", "1", "--out", "out"), 2, ("campaign.json", *says),
+           setup=setup, group=f"campaign-manifest-{name}")
+      for name, setup, says in (
+          ("cells-are-text", _write("out/campaign.json", _manifest(cells=["baseline"])), ("cells[0]",)),  # the crash
+          ("searchers-text", _write("out/campaign.json", _manifest(searchers="random")), ("searchers",)),
+          ("seeds-huge", _write("out/campaign.json", _manifest(seeds=list(range(200_000)))), ("seeds",)),
+          ("budget-bool", _write("out/campaign.json", _manifest(budget=True)), ("budget",)),
+          ("sha-not-hex", _write("out/campaign.json", _manifest(cells=[{"name": "baseline", "source": "baseline",
+                                                                       "sha256": "x"}])), ("cells[0].sha256",)),
+          ("key-twice", _write("out/campaign.json", _manifest()[:-1] + b', "budget": 3}'), ("'budget' appears twice",)),
+          ("not-json", _write("out/campaign.json", b"{"), ("invalid JSON",)),
+          ("list", _write("out/campaign.json", b"[]"), ("not a campaign manifest",)),
+          ("fifo", _fifo("out/campaign.json"), ("not a regular file",)),
+          ("link", _link("out/campaign.json", "../in/victim.txt"), ("symbolic link",)),
+      )),
 ]
 
 CASES = _cell_cases() + _result_cases() + NAMED + OPTIONS

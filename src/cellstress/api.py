@@ -88,16 +88,18 @@ def write_report(result: SearchResult | str | Path, out: str | Path | None = Non
     return _write_report(result, out)
 
 
-def verify(cell: CellLike, *, horizon: int | None = None, phases: str = "all", time_limit: float | None = None,
-           workers: int = 1, out: str | Path | None = None, criterion: str | None = None,
-           progress: Callable[[int, int], None] | None = None) -> VerifyResult:
+def verify(cell: CellLike, *, horizon: int | None = None, phases: str = "all", moments: str = "all",
+           time_limit: float | None = None, workers: int = 1, out: str | Path | None = None,
+           criterion: str | None = None, progress: Callable[[int, int], None] | None = None) -> VerifyResult:
     """Decide exactly whether any sequence of ``horizon`` worker actions (default: the cell's
     ``actions_per_episode``) reaches the unsafe set, from every start point, at every arrival phase of the robot's
-    cycle on the time-step grid (``phases="all"``) or at the cell's own phases (``"cell"``).
+    cycle on the time-step grid (``phases="all"``) or at the cell's own phases (``"cell"``); with
+    ``moments="all"`` each grid phase also stands for the arrival moments within half a step of it where the cell
+    allows it (``"grid"``: the grid alone). ``.scope`` says exactly what the verdict covers.
 
     ``.verdict`` is ``PROVED-SAFE``, ``UNSAFE`` or ``UNDECIDED`` (``time_limit`` [s] ran out; never a proof);
     ``.hazardous`` the exact number of hazardous sequences, per sub-tree in ``.subtrees``; ``.classes`` one witness
     per hazard class. ``workers`` processes decide sub-trees in parallel; ``out``: a folder for verify.json and
     the witnesses' replayable result files. docs/verify.md says what a proof means."""
-    return verify_cell(Simulator(_cell(cell, criterion)), horizon=horizon, phases=phases, time_limit=time_limit,
-                       workers=workers, out=out, progress=progress)
+    return verify_cell(Simulator(_cell(cell, criterion)), horizon=horizon, phases=phases, moments=moments,
+                       time_limit=time_limit, workers=workers, out=out, progress=progress)

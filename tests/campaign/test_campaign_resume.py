@@ -189,12 +189,69 @@ def test_an_unreadable_manifest_or_runs_without_one(tmp_path, capsys):
     out.mkdir()
     (out / MANIFEST).write_text("[1, 2")
     code, _, err = _campaign(out, capsys=capsys)
-    assert code == 2 and "campaign.json is not readable" in err
+    assert code == 2 and "campaign.json: not a campaign manifest: (file): invalid JSON" in err
     out2 = tmp_path / "orphan"
     out2.mkdir()
     (out2 / RUNS).write_text("")
     code, _, err = _campaign(out2, capsys=capsys)
     assert code == 2 and "no campaign.json" in err
+
+
+@pytest.mark.parametrize(("change", "says"), [
+    (lambda m: m.update(cells=["s1-scanner-width"]), "cells[0]: Input should be an object"),  # the crash of issue 29
+    (lambda m: m.update(searchers="random"), "searchers: Input should be a valid array"),
+    (lambda m: m["cells"][0].update(sha256="x" * 64), "cells[0].sha256: String should match pattern"),
+    (lambda m: m.update(budget=True), "budget: Input should be a valid integer"),
+    (lambda m: m.update(seeds=list(range(200_000))), "seeds: Tuple should have at most 100000 items"),
+    (lambda m: m["searchers"][0].update(params={"ec": [1] * 5}), "searchers[0].params.ec"),
+    (lambda m: m.update(evil=1), "evil: Extra inputs are not permitted"),
+])
+def test_a_forged_manifest_is_one_clear_error(done, tmp_path, capsys, change, says):
+    """campaign.json comes from the folder, which may come from anyone: checked as a typed record (issue 29)."""
+    out = _copy(done, tmp_path / "forged")
+    doc = json.loads((out / MANIFEST).read_text())
+    change(doc)
+    (out / MANIFEST).write_text(json.dumps(doc))
+    code, _, err = _campaign(out, capsys=capsys)
+    assert code == 2 and err.startswith("error: ") and err.count("\n") == 1, err
+    assert f"{out / MANIFEST}: not a campaign manifest: {says}" in err, err
+
+
+def test_a_manifest_with_a_repeated_key_is_refused(done, tmp_path, capsys):
+    out = _copy(done, tmp_path / "twice")
+    text = (out / MANIFEST).read_text()
+    (out / MANIFEST).write_text(text.replace('"budget": 12', '"budget": 99, "budget": 12'))
+    code, _, err = _campaign(out, capsys=capsys)
+    assert code == 2 and "campaign.json: not a campaign manifest: the key 'budget' appears twice" in err, err
+
+
+@pytest.mark.parametrize(("change", "says"), [
+    (lambda r: r.update(episodes="many"), "episodes: Input should be a valid integer"),
+    (lambda r: r.update(episodes=10**6), "episodes: 1,000,000 played, more than the budget of 12"),
+    (lambda r: r.update(found=True, hazard=None), "found: true, but the line has no hazard"),
+    (lambda r: r.update(hazard="boom"), "hazard: Input should be an object"),
+])
+def test_a_forged_run_line_is_one_clear_error(done, tmp_path, capsys, change, says):
+    out = _copy(done, tmp_path / "forged-run")
+    lines = (out / RUNS).read_text().splitlines()
+    rec = json.loads(lines[0])
+    change(rec)
+    lines[0] = json.dumps(rec, sort_keys=True)
+    (out / RUNS).write_text("\n".join(lines) + "\n")
+    code, _, err = _campaign(out, capsys=capsys)
+    assert code == 2 and err.count("\n") == 1 and "line 1 is not a run record" in err and says in err, err
+
+
+@pytest.mark.parametrize("name", [MANIFEST, RUNS])
+def test_a_link_planted_in_the_folder_is_refused(done, tmp_path, capsys, name):
+    out = _copy(done, tmp_path / "linked")
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me\n")
+    (out / name).replace(tmp_path / f"moved-{name}")
+    (out / name).symlink_to(victim)
+    code, _, err = _campaign(out, capsys=capsys)
+    assert code == 2 and err.count("\n") == 1 and f"{out / name}: is a symbolic link" in err, err
+    assert victim.read_text() == "keep me\n"
 
 
 def test_two_campaigns_cannot_share_a_folder(done, tmp_path, capsys):

@@ -266,6 +266,28 @@ CASES = [
         ("before the pallet has passed",),
         lambda c: f"devices[{_index(c, 'light-curtain')}].muting",
     ),
+    # the cell's clock runs modulo the robot's cycle (the baseline's: 5.71 s): a window must fit in it (issue 29)
+    Case(
+        "muting-longer-than-the-cycle",
+        lambda c: c["devices"][_index(c, "light-curtain")].update(muting={"pallet": [0.0, 2.0], "until": 500.0}),
+        None,
+        ("lasts 500 s", "longer than the robot's cycle of 5.7"),
+        lambda c: f"devices[{_index(c, 'light-curtain')}].muting",
+    ),
+    Case(
+        "muting-after-the-cycle",
+        lambda c: c["devices"][_index(c, "light-curtain")].update(muting={"pallet": [7.0, 8.0], "until": 8.0}),
+        None,
+        ("starts at 7 s", "after the robot's cycle"),
+        lambda c: f"devices[{_index(c, 'light-curtain')}].muting",
+    ),
+    Case(
+        "warning-field-inside-the-protective-field",
+        lambda c: _scanner(c).update(warning={"polygon": [[p[0] * 0.5, p[1] * 0.5] for p in _scanner(c)["polygon"]]}),
+        None,
+        ("warning.polygon must contain the protective field", "lies outside the warning field"),
+        lambda c: f"devices[{_index(c, 'laser-scanner')}]",
+    ),
     # speed and separation monitoring (issue 18)
     Case(
         "ssm-max-speed-zero",

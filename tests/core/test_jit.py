@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import ast
+import hashlib
 import json
 import os
 import pickle
 import platform
+import stat
 import subprocess
 import sys
 import zipfile
@@ -15,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from cellstress.core import jit
+from cellstress.core.jit import caching, numba
 
 ROOT = Path(__file__).resolve().parents[2]
 SRC = ROOT / "src" / "cellstress"
@@ -24,6 +27,7 @@ SRC = ROOT / "src" / "cellstress"
 CHILD = r"""
 import json, sys
 from cellstress.core import jit
+from cellstress.core.jit import caching, numba
 from cellstress.core.jit import event
 compiled = []
 class L(event.Listener):
@@ -116,36 +120,165 @@ def test_a_cpu_the_user_chose_is_kept(tmp_path):
     assert p.stdout.split() == ["False", "host"]
 
 
-def test_seeding_keeps_entries_numba_wrote_and_adds_the_archives(tmp_path, monkeypatch):
-    manifest = jit.read_manifest()
+class Planted:
+    """A pickle that runs code when unpickled: it makes the folder ``marker``."""
+
+    def __init__(self, marker: Path):
+        self.marker = marker
+
+    def __reduce__(self):
+        return (os.mkdir, (str(self.marker),))
+
+
+def _one_index(manifest: dict) -> tuple[dict, str, list[str]]:
+    """The archive's manifest cut to its first index, with no source to be fresh (so the test does not depend on
+    the archive being current), the index's member name and its entries (data files, then the index)."""
     member, source = next(iter(manifest["indexes"].items()))
-    monkeypatch.setattr(jit, "cache_folder", lambda _source: tmp_path)
     with zipfile.ZipFile(jit.ARCHIVE) as z:
-        stamp, shipped = jit.parse_index(z.read(member))
-    name = Path(member).name
-    base = name[: -len(".nbi")]
-    # an index numba wrote for the same source, with one entry of its own in data file 1
-    (tmp_path / f"{base}.1.nbc").write_bytes(b"numba's own")
-    (tmp_path / name).write_bytes(jit.index_bytes(stamp, {("own", "key"): f"{base}.1.nbc"}))
-    manifest = dict(manifest, indexes={member: source})
-    added = jit.seed(manifest=manifest)
-    assert added == len(shipped)
-    _, overloads = jit.parse_index((tmp_path / name).read_bytes())
-    assert overloads[("own", "key")] == f"{base}.1.nbc"
-    assert (tmp_path / f"{base}.1.nbc").read_bytes() == b"numba's own"
-    assert set(shipped) <= set(overloads) and len(set(overloads.values())) == len(overloads)
-    assert jit.seed(manifest=manifest) == 0  # nothing left to add
+        entries = jit.entries_of(member, set(z.namelist()))
+    return dict(manifest, indexes={member: source}, closures={source: []}), member, entries
 
 
-def test_a_stale_index_is_replaced(tmp_path, monkeypatch):
-    manifest = jit.read_manifest()
-    member, source = next(iter(manifest["indexes"].items()))
-    monkeypatch.setattr(jit, "cache_folder", lambda _source: tmp_path)
+def _archive_bytes(member: str) -> bytes:
+    with zipfile.ZipFile(jit.ARCHIVE) as z:
+        return z.read(member)
+
+
+@pytest.fixture
+def private(tmp_path, monkeypatch) -> Path:
+    folder = tmp_path / "cache"
+    folder.mkdir(mode=0o700)
+    monkeypatch.setattr(jit, "numba_folder", lambda _source: folder)
+    return folder
+
+
+@pytest.mark.parametrize("hashes", ["in the manifest", "from the archive"])
+def test_seeding_compares_by_hash_and_never_unpickles_what_is_there(tmp_path, private, hashes):
+    """Issue 29: a cached index is compared with the archive's by SHA-256 and replaced, never unpickled. An
+    archive built before per-entry hashes (no ``files``) is compared with its own bytes."""
+    manifest, member, entries = _one_index(jit.read_manifest())
+    if hashes == "in the manifest":
+        manifest["files"] = {m: hashlib.sha256(_archive_bytes(m)).hexdigest() for m in entries}
+    else:
+        manifest.pop("files", None)
+    marker = tmp_path / "pwned"
+    bad = pickle.dumps(numba.__version__, protocol=-1) + pickle.dumps(Planted(marker))
+    for m in entries:
+        (private / Path(m).name).write_bytes(bad)
+    assert jit.seed(manifest=manifest) == len(entries)
+    assert not marker.exists()
+    for m in entries:
+        assert (private / Path(m).name).read_bytes() == _archive_bytes(m)
+    assert jit.seed(manifest=manifest) == 0  # the same bytes: nothing to write
+    assert jit.parse_index((private / Path(member).name).read_bytes()) is not None
+
+
+def test_an_index_numba_wrote_for_other_signatures_is_replaced(private):
+    manifest, member, entries = _one_index(jit.read_manifest())
+    stamp, shipped = jit.parse_index(_archive_bytes(member))
     name = Path(member).name
-    (tmp_path / name).write_bytes(jit.index_bytes(b"another source", {("old",): "x.nbc"}))
-    assert jit.seed(manifest=dict(manifest, indexes={member: source})) > 0
-    stamp, overloads = jit.parse_index((tmp_path / name).read_bytes())
-    assert stamp != b"another source" and ("old",) not in overloads
+    (private / name).write_bytes(jit.index_bytes(stamp, {("own", "key"): "x.99.nbc", **shipped}))
+    assert jit.seed(manifest=manifest) >= 1
+    assert (private / name).read_bytes() == _archive_bytes(member)
+
+
+def test_a_damaged_entry_is_not_seeded(private):
+    manifest, member, entries = _one_index(jit.read_manifest())
+    manifest["files"] = {m: hashlib.sha256(_archive_bytes(m)).hexdigest() for m in entries}
+    manifest["files"][entries[0]] = "0" * 64
+    assert jit.seed(manifest=manifest) == 0
+    assert list(private.iterdir()) == []
+
+
+def test_a_shared_folder_is_never_seeded(tmp_path, monkeypatch):
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o777)
+    monkeypatch.setattr(jit, "numba_folder", lambda _source: shared)
+    manifest, _, _ = _one_index(jit.read_manifest())
+    assert jit.seed(manifest=manifest) == 0
+    assert list(shared.iterdir()) == []
+
+
+def test_a_missing_folder_is_made_for_this_user_only(tmp_path, monkeypatch):
+    folder = tmp_path / "a" / "b"
+    monkeypatch.setattr(jit, "numba_folder", lambda _source: folder)
+    old = os.umask(0o002)
+    try:
+        manifest, _, entries = _one_index(jit.read_manifest())
+        assert jit.seed(manifest=manifest) == len(entries)
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(folder.stat().st_mode) == 0o700 and stat.S_IMODE(folder.parent.stat().st_mode) == 0o700
+
+
+def test_who_else_can_write_a_folder(tmp_path):
+    own = tmp_path / "own"
+    own.mkdir(mode=0o700)
+    assert jit.others_can_write(own) is None
+    assert jit.others_can_write(own / "not" / "made" / "yet") is None
+    own.chmod(0o770)
+    assert jit.others_can_write(own) == f"{own} is writable by its group"
+    own.chmod(0o707)
+    assert jit.others_can_write(own) == f"{own} is writable by every user"
+    sticky = tmp_path / "tmp"
+    sticky.mkdir()
+    sticky.chmod(0o1777)  # as /tmp: others add files but cannot move ours
+    (sticky / "mine").mkdir(mode=0o700)
+    assert jit.others_can_write(sticky / "mine") is None
+    assert jit.others_can_write(sticky) is not None  # but the sticky folder itself takes anyone's files
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o777)
+    (shared / "mine").mkdir(mode=0o700)
+    assert jit.others_can_write(shared / "mine") == f"{shared} is writable by every user"
+    (tmp_path / "link").symlink_to(shared / "mine")  # a link leads into the shared folder: judged where it leads
+    assert jit.others_can_write(tmp_path / "link") == f"{shared} is writable by every user"
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="only root can give a folder to another user")
+def test_a_folder_of_another_user(tmp_path):
+    other = tmp_path / "other"
+    other.mkdir(mode=0o700)
+    os.chown(other, 65534, 65534)
+    assert jit.others_can_write(other) == f"{other} belongs to another user"
+
+
+PLANTED_CHILD = r"""
+import numpy as np
+from cellstress.sim import geometry
+from cellstress.core import jit
+from cellstress.core.jit import caching, numba
+from numba.core import config
+verts = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+print(geometry.point_in_polygon(0.2, 0.2, verts, 0, 3), config.CACHE_DIR)
+"""
+
+
+def test_a_pickle_planted_in_a_shared_cache_is_never_loaded(tmp_path):
+    """Issue 29: an index planted in a world-writable NUMBA_CACHE_DIR ran its code on import. Now numba is kept
+    from that folder (one warning line) and caches in a folder only this user can write."""
+    from cellstress.sim import geometry
+
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o777)
+    marker = tmp_path / "pwned"
+    impl = caching.CompileResultCacheImpl(geometry.point_in_polygon.py_func)
+    folder = shared / caching._CacheLocator.get_suitable_cache_subpath(geometry.__file__)
+    folder.mkdir()
+    (folder / f"{impl.filename_base}.nbi").write_bytes(
+        pickle.dumps(numba.__version__, protocol=-1) + pickle.dumps(Planted(marker)))
+    e = dict(os.environ, NUMBA_CACHE_DIR=str(shared), CELLSTRESS_CACHE=str(tmp_path / "mine"))
+    p = subprocess.run([sys.executable, "-c", PLANTED_CHILD], env=e, capture_output=True, text=True, timeout=900)
+    assert p.returncode == 0, p.stderr
+    assert not marker.exists()
+    mine = tmp_path / "mine" / f"numba-{jit.python_tag()}"
+    assert p.stdout.split() == ["True", str(mine)]
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("warning: numba's cache folder") and str(shared) in lines[0]
+    assert f"{shared} is writable by every user" in lines[0] and str(mine) in lines[0]
+    assert stat.S_IMODE(mine.stat().st_mode) == 0o700
 
 
 def test_a_damaged_archive_or_index_is_ignored(tmp_path):
@@ -162,3 +295,26 @@ def test_a_damaged_archive_or_index_is_ignored(tmp_path):
     good = jit.read_manifest()
     assert not jit.manifest_matches(dict(good, machine="aarch64"))
     assert not jit.manifest_matches(dict(good, cpu_features=good["cpu_features"] + ["a-feature-no-cpu-has"]))
+
+
+def test_the_build_script_records_each_entrys_hash(tmp_path, monkeypatch):
+    """scripts/build_kernel_cache.py packs a manifest whose ``files`` are the sha256 of every packed entry, in
+    the format jit.seed reads (issue 29)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("build_kernel_cache", ROOT / "scripts" / "build_kernel_cache.py")
+    build = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(build)
+    monkeypatch.setattr(build, "ARCHIVE", tmp_path / "kernel_cache.zip")
+    cache = tmp_path / "numba"
+    folder = cache / caching._CacheLocator.get_suitable_cache_subpath(str(SRC / "sim" / "geometry.py"))
+    folder.mkdir(parents=True)
+    (folder / "geometry.f-1.py311.nbi").write_bytes(b"index")
+    (folder / "geometry.f-1.py311.1.nbc").write_bytes(b"data")
+    manifest = build.pack(cache)
+    assert manifest["files"] == {"sim/geometry.f-1.py311.nbi": hashlib.sha256(b"index").hexdigest(),
+                                 "sim/geometry.f-1.py311.1.nbc": hashlib.sha256(b"data").hexdigest()}
+    assert jit.read_manifest(tmp_path / "kernel_cache.zip")["files"] == manifest["files"]
+    with zipfile.ZipFile(tmp_path / "kernel_cache.zip") as z:
+        assert jit.entries_of("sim/geometry.f-1.py311.nbi", set(z.namelist())) == [
+            "sim/geometry.f-1.py311.1.nbc", "sim/geometry.f-1.py311.nbi"]

@@ -56,6 +56,26 @@ def test_warning_field_distances_by_hand():
     assert scanner().warning_distance(0.15) is None
 
 
+@pytest.mark.parametrize("warning", [
+    FIELD,  # the same field: contains it (a shared boundary is inside)
+    ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.5, 1.5), (0.0, 1.0)),  # sharing three edges
+])
+def test_a_warning_field_around_the_protective_field_is_accepted(warning):
+    assert scanner(warning={"polygon": warning}).warning is not None
+
+
+@pytest.mark.parametrize("warning", [
+    ((0.2, 0.2), (0.8, 0.2), (0.8, 0.8), (0.2, 0.8)),  # inside the protective field (issue 29)
+    ((2.0, 2.0), (3.0, 2.0), (3.0, 3.0)),  # apart
+    ((-1.0, -1.0), (0.9, -1.0), (0.9, 2.0), (-1.0, 2.0)),  # a corner of the protective field pokes out
+    # a U around it whose notch cuts into the protective field: every corner is inside, an edge is not
+    ((-1.0, -1.0), (2.0, -1.0), (2.0, 2.0), (0.6, 2.0), (0.6, 0.5), (0.4, 0.5), (0.4, 2.0), (-1.0, 2.0)),
+])
+def test_a_warning_field_must_contain_the_protective_field(warning):
+    with pytest.raises(ValidationError, match="warning.polygon must contain the protective field"):
+        scanner(warning={"polygon": warning})
+
+
 def test_warning_field_channels():
     s = scanner(response_time=0.35, warning={"polygon": WIDE, "reduced_speed": 0.4, "restart": {"automatic": 1.0}})
     stop, warn = s.channels()

@@ -167,7 +167,7 @@ ROW0 = "0,1.4,-0.8,1.3,-2.1,-1.57,0\n"
 @pytest.mark.parametrize("text, words", [
     ("", ("empty",)),
     ("time,a,b\n" + ROW0, ("header must be", "q1", "shoulder_pan_joint")),
-    (HEAD + ROW0 + "1,1.4,-0.8,x,-2.1,-1.57,0\n", ("row 3, column 4 (q3)", "'x' is not a number")),
+    (HEAD + ROW0 + "1,1.4,-0.8,x,-2.1,-1.57,0\n", ("row 3, column 4 (q3)", "is not a number")),
     (HEAD + ROW0 + "1,1.4,-0.8,nan,-2.1,-1.57,0\n", ("row 3, column 4 (q3)", "not a finite")),
     (HEAD + ROW0 + "1,1.4,-0.8\n", ("row 3", "has 3 values; expected 7")),
     (HEAD + ROW0 + "0,1.4,-0.8,1.3,-2.1,-1.57,0\n", ("row 3, column 1 (time)", "not after")),
@@ -188,6 +188,30 @@ def test_bad_trajectory_file(tmp_path, baseline, text, words):
 def test_trajectory_file_too_many_rows(tmp_path, baseline):
     err = _csv_error(tmp_path, baseline, HEAD + ROW0 * 200_002)
     assert "more than 200,000 rows" in err.problem
+
+
+@pytest.mark.parametrize("text", [
+    HEAD + ROW0 * 200_000 + ROW0.rstrip("\n"),  # 200,001 rows, no final newline (issue 29)
+    (HEAD + ROW0 * 200_001).replace("\n", "\r"),  # old Mac line ends: no newline at all
+])
+def test_trajectory_file_rows_are_counted_whatever_ends_them(tmp_path, baseline, text):
+    err = _csv_error(tmp_path, baseline, text)
+    assert "more than 200,000 rows" in err.problem
+
+
+@pytest.mark.parametrize("text", [
+    "root:x:0:0:root:/root:/bin/bash\ndaemon:x:1:1:daemon:/usr/sbin:/usr/sbin/nologin\n",
+    "time,q1,q2,q3,q4,q5,SECRET-TOKEN\n" + ROW0 * 3,
+    HEAD + ROW0 + "1,1.4,-0.8,SECRET-TOKEN,-2.1,-1.57,0\n",
+    HEAD + ROW0 + "1,1.4,-0.8,1e999,-2.1,-1.57,0\n",
+])
+def test_an_error_never_quotes_the_file(tmp_path, baseline, text):
+    """A cell may name any file as its trajectory (/etc/passwd, ~/secret.csv): the error names the row and the
+    column, never the file's words (issue 29)."""
+    err = _csv_error(tmp_path, baseline, text)
+    assert "row" in err.problem or "column" in err.problem
+    for secret in ("root:x", "daemon", "SECRET", "1e999"):
+        assert secret not in str(err), str(err)
 
 
 def test_trajectory_file_missing(tmp_path, baseline):

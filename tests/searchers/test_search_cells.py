@@ -64,8 +64,10 @@ def test_result_file_contents(sims, tmp_path) -> None:
     doc = json.loads(res.write(tmp_path).read_text())
     assert set(doc) == {"cell", "searcher", "params", "seed", "budget", "until", "found", "episodes", "hazard",
                         "hazards", "top", "risk_per_episode", "distinct_sequences", "version", "format"}
+    files = doc["cell"].pop("files")
     assert doc["cell"] == {"name": "s3-fence-gap", "sha256": sim.cell.sha256, "source": "s3-fence-gap",
                            "criterion": "contact-while-moving"}
+    assert files == [f.model_dump() for f in sim.cell.files] and files[0]["sha256"] == sim.cell.sha256
     assert 1 <= doc["distinct_sequences"] <= doc["episodes"]
     assert doc["searcher"] == "mcts" and doc["params"] == {"ec": 0.5, "k": 1.0, "alpha": 0.85}
     assert doc["version"] == cellstress.__version__

@@ -5,6 +5,8 @@ at rest never moving again."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -14,7 +16,11 @@ from cellstress.sim.simulator import Simulator
 from cellstress.verifier.bounds import Bounds
 from cellstress.verifier.reach import SweptField, robot_point_speed, worker_radius
 
-CELLS = ["baseline", "s1-scanner-width", "s3-fence-gap"]
+FEATURES = Path(__file__).parent / "cells"
+# the paper's cells, a prismatic joint (linear-axis), a guard door and a muted curtain (the bounds' cells: every
+# stop latches)
+CELLS = ["baseline", "s1-scanner-width", "s3-fence-gap", str(FEATURES / "linear-axis.yaml"),
+         str(FEATURES / "door-near.yaml"), str(FEATURES / "muting-near.yaml")]
 
 
 @pytest.mark.parametrize("cell", CELLS)
@@ -70,12 +76,14 @@ def test_distance_bound_never_above_a_later_d_hr(cell) -> None:
                     assert later[j - 1, L.M_D] >= lb - field.radius
 
 
-def test_a_robot_at_rest_stays_at_rest() -> None:
-    sim = Simulator("baseline")  # its devices stop the robot when the worker walks in
-    bounds = Bounds(sim, horizon=8)
+@pytest.mark.parametrize("cell", ["baseline", str(FEATURES / "linear-axis.yaml"), "door-unlocked"])
+def test_a_robot_at_rest_stays_at_rest(cell) -> None:
+    sim = Simulator(cell)  # its devices stop the robot when the worker walks in (or pushes the door)
+    n = max(8, sim.actions_per_episode)
+    bounds = Bounds(sim, horizon=n)
     rng = np.random.default_rng(3)
     rested = 0
-    for acts in rng.integers(0, 6, size=(150, 8)):  # walking (with any posture), into the cell
+    for acts in rng.integers(0, 6, size=(150, n)):  # walking (with any posture), into the cell
         rows = sim.run(acts).rows
         t_stop = np.inf
         state = sim.reset()
@@ -89,7 +97,7 @@ def test_a_robot_at_rest_stays_at_rest() -> None:
                 assert np.all(later[:, L.M_V] == 0.0) and not later[:, L.M_UNSAFE].any()
                 rested += 1
                 break
-    assert rested > 20
+    assert rested >= 5  # (most walks in linear-axis end at the arm first)
 
 
 def test_no_bound_when_a_device_restarts_or_slows_the_robot():

@@ -1,14 +1,18 @@
-"""The exact decision against brute force: for short horizons, the hazardous-sequence count of every built-in
-cell (one start point each, at its own phase and at another) equals enumerating all 30^k sequences with
-``Simulator.run_batch``; every witness is a real, bit-exact episode; a searcher's hazard lies in the verifier's
-hazardous set."""
+"""The exact decision against brute force: at 3 and 4 actions the hazardous-sequence count of every built-in
+cell (one start point each, at its own phase and at another) and of test cells made to have hazards there
+for each feature (automatic restart, warning field, speed and separation monitoring, guard door, muting,
+several robots, a prismatic joint: tests/verifier/cells) equals playing every sequence: all 30^3 with
+``Simulator.run_batch``, all 30^4 prefix by prefix without merging or bounds (``verify_brute``); every witness
+is a real, bit-exact episode; a searcher's hazard lies in the verifier's hazardous set."""
 
 from __future__ import annotations
 
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pytest
+from verify_brute import brute_force
 
 import cellstress
 from cellstress.cell.load import BUILTIN_CELLS, load_cell
@@ -45,10 +49,55 @@ def test_counts_equal_brute_force_three_actions(cell, phase) -> None:
     assert out.hazardous + out.safe == 30 ** 3
 
 
-def test_counts_equal_brute_force_four_actions() -> None:
-    sim = _start_sim("s1-scanner-width")
+CELLS = Path(__file__).parent / "cells"
+# (test cell, arrival phases where its feature decides hazards within 3-4 actions)
+FEATURE_CELLS = [
+    ("restart-fast", (0.0, 2.5)),  # automatic restart after 0.1 s
+    ("warning-trunk", (4.35, 0.55)),  # a trunk-height warning field that releases after 0.1 s
+    ("ssm-near", (1.0, 2.0)),  # speed and separation monitoring
+    ("door-near", (0.0,)),  # a guard door without guard locking
+    ("muting-near", (4.0,)),  # a muted curtain
+    ("two-near", (0.0,)),  # two robots, the curtain stopping one
+    ("linear-axis", (0.0, 1.0)),  # a prismatic joint, a long stop
+]
+
+
+def _feature_sim(name: str, phase: float) -> Simulator:
+    sim = Simulator(str(CELLS / f"{name}.yaml"))
+    return sim.with_start(start_points(sim.cell)[0].pose, phase)
+
+
+@pytest.mark.parametrize(("cell", "phase"), [(c, p) for c, ps in FEATURE_CELLS for p in ps])
+def test_feature_cells_equal_brute_force_three_actions(cell, phase) -> None:
+    sim = _feature_sim(cell, phase)
+    out = decide(sim, 3, Bounds(sim, horizon=3))
+    assert out.decided
+    assert out.hazardous == _brute_force(sim, 3) > 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("cell", "phase"), [(c, ps[0]) for c, ps in FEATURE_CELLS])
+def test_feature_cells_equal_brute_force_four_actions(cell, phase) -> None:
+    sim = _feature_sim(cell, phase)
     out = decide(sim, 4, Bounds(sim, horizon=4))
-    assert out.hazardous == _brute_force(sim, 4) > 0
+    assert out.decided
+    assert out.hazardous == brute_force(sim, 4) > 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("cell", PAPER_CELLS)
+def test_counts_equal_brute_force_four_actions(cell) -> None:
+    sim = _start_sim(cell)
+    out = decide(sim, 4, Bounds(sim, horizon=4))
+    assert out.decided
+    assert out.hazardous == brute_force(sim, 4)
+
+
+@pytest.mark.parametrize("cell", ["s1-scanner-width", "restart-auto"])
+def test_the_brute_force_tree_plays_what_run_batch_plays(cell) -> None:
+    # the prefix-by-prefix brute force of the four-action checks, against every episode played whole
+    sim = _start_sim(cell, 3.0)
+    assert brute_force(sim, 3) == _brute_force(sim, 3)
 
 
 def test_witnesses_are_played_bit_exactly() -> None:

@@ -1,7 +1,8 @@
 """Check a result file: every claim it makes is computed again, none is taken on trust.
 
 A result file comes from somebody else, so ``cellstress replay`` vouches for nothing it has not recomputed:
-- the cell's text must hash to the sha256 recorded;
+- the cell's text must hash to the sha256 recorded, and every file the cell reads (its URDFs, meshes,
+  trajectory files) to the sha256 recorded for it: a difference names the file that changed;
 - the hazard replayed (its actions, in that cell, under that criterion) must give the recorded summary (unsafe
   step, time, robot link, body part, points, d_HR, v_R, the criterion's verdict) and every trace row, bit for
   bit;
@@ -18,6 +19,7 @@ from dataclasses import dataclass
 
 from cellstress.cell.load import load_cell, with_criterion
 from cellstress.cell.schema import DEFAULT_CRITERION
+from cellstress.core.provenance import file_changes
 from cellstress.core.version import __version__
 from cellstress.searchers import distinct_record, hazard_record, search
 from cellstress.searchers.common import SearchError
@@ -55,6 +57,8 @@ def check_result(res: SearchResult, index: int | None = None, *, search_again: b
     if cell.sha256 != res.cell.sha256:
         problems.append(f"cell.sha256: the cell differs from the one searched (sha256 {cell.sha256[:12]} != "
                         f"{res.cell.sha256[:12]})")
+    if res.cell.files is not None:  # every file the cell read: which one changed (absent from older files)
+        problems += [f"cell.files: {change}" for change in file_changes(res.cell.files, cell.files)]
     if cell.name != res.cell.name:
         problems.append(f"cell.name: the file says {res.cell.name!r}, the cell is {cell.name!r}")
     actions = list(listed.actions)
@@ -101,8 +105,9 @@ def _search_again(res: SearchResult, sim: Simulator) -> list[str]:
     # files written before these fields existed make no claim about them
     if "distinct_sequences" not in recorded:
         rerun.pop("distinct_sequences", None)
-    if "criterion" not in recorded["cell"]:
-        rerun["cell"].pop("criterion", None)
+    for key in ("criterion", "files"):
+        if key not in recorded["cell"]:
+            rerun["cell"].pop(key, None)
     old_distinct = recorded.get("distinct") or ()
     if old_distinct and "severity" not in old_distinct[0] and rerun.get("distinct"):
         rerun["distinct"].sort(key=lambda d: d["episode"])  # such files list the classes in the order found

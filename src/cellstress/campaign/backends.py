@@ -10,26 +10,18 @@ driver) do not survive a fork, and a forked child could inherit a half-held lock
 
 from __future__ import annotations
 
-import os
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
 from cellstress.campaign.plan import CampaignError, RunSpec
 from cellstress.campaign.worker import execute, execute_threaded, init_worker
+from cellstress.core.cpus import check_workers, usable_cpus
+from cellstress.core.errors import CellstressError
 
 BACKENDS = ("processes", "ray")
 RAY_HINT = "pip install 'cellstress[ray]'"
-MAX_LOCAL_WORKERS_PER_CORE = 4  # each is a process with its own compiled simulators (a few hundred MB)
 MAX_RAY_TASKS = 100_000
-
-
-def cpu_count() -> int:
-    """Cores this process may use (the affinity mask, not the machine's total, where the OS tells it)."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # not on Linux
-        return max(1, os.cpu_count() or 1)
 
 
 @dataclass(frozen=True)
@@ -44,11 +36,16 @@ class Backend:
     def __post_init__(self) -> None:
         if self.name not in BACKENDS:
             raise CampaignError(f"--backend must be one of {', '.join(BACKENDS)}, not {self.name!r}")
-        most = MAX_RAY_TASKS if self.name == "ray" else MAX_LOCAL_WORKERS_PER_CORE * cpu_count()
-        if self.workers is not None and (isinstance(self.workers, bool) or not isinstance(self.workers, int)
-                                         or not 1 <= self.workers <= most):
-            raise CampaignError(f"--workers must be a whole number in 1..{most} (each local worker is a process "
-                                f"of its own), not {self.workers!r}")
+        if self.name == "ray":
+            if self.workers is not None and (isinstance(self.workers, bool) or not isinstance(self.workers, int)
+                                             or not 1 <= self.workers <= MAX_RAY_TASKS):
+                raise CampaignError(f"--workers must be a whole number in 1..{MAX_RAY_TASKS} (Ray tasks at a "
+                                    f"time), not {self.workers!r}")
+        else:
+            try:  # local workers: the bound every --workers shares (core.cpus)
+                check_workers(self.workers)
+            except CellstressError as exc:
+                raise CampaignError(str(exc)) from None
         if self.address is not None and self.name != "ray":
             raise CampaignError("--address is the address of a Ray cluster: use it with --backend ray")
 
@@ -65,7 +62,7 @@ class Backend:
         return "1 worker (this process)" if w == 1 else f"{w} worker processes"
 
     def local_workers(self, n_runs: int) -> int:
-        return max(1, min(self.workers or cpu_count(), n_runs))
+        return max(1, min(self.workers or usable_cpus(), n_runs))
 
     def run(self, specs: list[RunSpec]) -> Iterator[dict[str, Any]]:
         """The records of ``specs``, each as soon as its run has finished."""
@@ -123,7 +120,7 @@ def run_ray(specs: list[RunSpec], max_in_flight: int | None, address: str | None
         kwargs: dict[str, Any] = {"address": address, "include_dashboard": False,
                                   "logging_level": logging.WARNING}
         if address is None:
-            kwargs["num_cpus"] = max_in_flight or cpu_count()
+            kwargs["num_cpus"] = max_in_flight or usable_cpus()
         try:
             ray.init(**kwargs)
         except (ConnectionError, ValueError, RuntimeError) as exc:

@@ -11,15 +11,19 @@ from __future__ import annotations
 import json
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
+
+from pydantic import Field
 
 from cellstress.campaign.paper import paper_table
 from cellstress.cell.load import BUILTIN_CELLS, load_cell
 from cellstress.core import registry
 from cellstress.core.errors import CellstressError
+from cellstress.core.fields import Name, Record
 from cellstress.core.version import __version__
 from cellstress.searchers import make_searcher, searcher_class, searcher_names
 from cellstress.searchers.common import MAX_BUDGET
+from cellstress.searchers.result import Option
 
 FORMAT = 1
 MANIFEST = "campaign.json"
@@ -183,6 +187,31 @@ def _show(value: Any) -> str:
     if isinstance(value, dict):
         return json.dumps(value, sort_keys=True)
     return str(value)
+
+
+class ManifestCell(Record):
+    name: Name
+    source: Annotated[str, Field(max_length=4096)]
+    sha256: Annotated[str, Field(pattern=r"^[0-9a-f]{64}$")]
+
+
+class ManifestSearcher(Record):
+    name: Name
+    params: Annotated[dict[Name, Option], Field(max_length=1000)]
+
+
+class Manifest(Record):
+    """``campaign.json`` as read back: a file in a folder that may come from anywhere (a shared drive), so it is
+    checked with strict types and bounded sizes before a resumed campaign compares it with its own options."""
+
+    format: Annotated[int, Field(ge=0, le=10**6)]
+    cellstress_version: Name
+    cells: Annotated[tuple[ManifestCell, ...], Field(max_length=MAX_CELLS)]
+    searchers: Annotated[tuple[ManifestSearcher, ...], Field(max_length=MAX_CELLS)]
+    seeds: Annotated[tuple[Annotated[int, Field(ge=0, le=MAX_SEEDS)], ...], Field(max_length=MAX_SEEDS)]
+    budget: Annotated[int, Field(ge=1, le=MAX_BUDGET)]
+    until: Name
+    runs: Annotated[int, Field(ge=0, le=MAX_CELLS * MAX_CELLS * MAX_SEEDS)]
 
 
 def manifest_difference(old: dict[str, Any], new: dict[str, Any]) -> str | None:

@@ -13,13 +13,66 @@ import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
-from cellstress.campaign.plan import MANIFEST, CampaignError, CampaignPlan, RunKey, manifest_difference
-from cellstress.core.io import atomic_write, atomic_write_text, canonical_json, json_line, json_ready
+from pydantic import Field, ValidationError, model_validator
+
+from cellstress.campaign.plan import MANIFEST, CampaignError, CampaignPlan, Manifest, RunKey, manifest_difference
+from cellstress.core.fields import Name, Record
+from cellstress.core.io import (
+    InputFileError,
+    atomic_write,
+    atomic_write_text,
+    canonical_json,
+    duplicate_json_key,
+    json_line,
+    json_ready,
+    read_input_bytes,
+)
+from cellstress.searchers.common import MAX_BUDGET
+from cellstress.searchers.result import MAX_ACTIONS, Option, validation_problem
 
 RUNS = "runs.jsonl"
 LOCK = ".campaign.lock"
+MAX_RUNS_BYTES = 2**30  # a run's line is about 500 bytes: two million runs (read whole, so memory is bounded)
+
+
+class RunHazard(Record):
+    episode: Annotated[int, Field(ge=1, le=MAX_BUDGET)]
+    actions: Annotated[tuple[Name, ...], Field(max_length=MAX_ACTIONS)]
+    step: Annotated[int, Field(ge=0, le=10**6)]
+    time_s: float
+    robot_link: Name | None
+    body_part: Name | None
+
+
+class RunRecord(Record):
+    """A line of ``runs.jsonl`` as read back (``worker.execute`` writes it): strict types, bounded sizes, and
+    the episode counts within the budget, so a forged line cannot reach the table as something else."""
+
+    format: Annotated[int, Field(ge=0, le=10**6)]
+    cell: Name
+    cell_sha256: Annotated[str, Field(pattern=r"^[0-9a-f]{64}$")]
+    searcher: Name
+    params: Annotated[dict[Name, Option], Field(max_length=1000)]
+    seed: Annotated[int, Field(ge=0)]
+    budget: Annotated[int, Field(ge=1, le=MAX_BUDGET)]
+    until: Name
+    found: bool
+    episodes: Annotated[int, Field(ge=0, le=MAX_BUDGET)]
+    hazard: RunHazard | None
+    version: Name
+
+    @model_validator(mode="after")
+    def _consistent(self) -> RunRecord:
+        if self.episodes > self.budget:
+            raise ValueError(f"episodes: {self.episodes:,} played, more than the budget of {self.budget:,}")
+        if self.found != (self.hazard is not None):
+            raise ValueError(f"found: {str(self.found).lower()}, but the line has "
+                             f"{'a' if self.hazard is not None else 'no'} hazard")
+        if self.hazard is not None and self.hazard.episode > self.episodes:
+            raise ValueError(f"hazard.episode: episode {self.hazard.episode:,} of {self.episodes:,}")
+        return self
 
 
 def record_key(rec: dict[str, Any]) -> RunKey:
@@ -36,9 +89,12 @@ class Loaded:
 
 def read_runs(path: Path, plan: CampaignPlan) -> Loaded:
     """Read ``runs.jsonl``; repair a truncated last line; check every line belongs to ``plan``."""
-    if not path.exists():
+    if not os.path.lexists(path):
         return Loaded({}, False)
-    raw = path.read_bytes()
+    try:
+        raw = read_input_bytes(path, MAX_RUNS_BYTES, follow=False)
+    except InputFileError as exc:
+        raise CampaignError(f"{path}: {exc.problem}") from None
     lines = raw.split(b"\n")
     tail = lines.pop()  # b"" when the file ends with a newline, else a line cut short by a crash
     dropped = bool(tail)
@@ -50,11 +106,16 @@ def read_runs(path: Path, plan: CampaignPlan) -> Loaded:
         if not line.strip():
             continue
         try:
-            rec = json.loads(line)
-            key = record_key(rec)
-        except (UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError, ValueError):
-            raise CampaignError(f"{path}: line {n} is not a run record; the file is damaged (move it away to "
-                                f"start over)") from None
+            RunRecord.model_validate_json(line, strict=True)
+        except ValidationError as exc:
+            raise CampaignError(f"{path}: line {n} is not a run record ({validation_problem(exc)}); the file is "
+                                f"damaged (move it away to start over)") from None
+        dup = duplicate_json_key(line)
+        if dup is not None:
+            raise CampaignError(f"{path}: line {n} is not a run record (the key {dup[:60]!r} appears twice); the "
+                                f"file is damaged (move it away to start over)")
+        rec = json.loads(line)
+        key = record_key(rec)
         spec = expected.get(key)
         if spec is None or rec.get("budget") != spec.budget or rec.get("cell_sha256") != spec.cell.sha256 \
                 or rec.get("params") != json_ready(spec.searcher.params_dict):
@@ -128,18 +189,23 @@ def open_manifest(out: Path, plan: CampaignPlan) -> bool:
     """Write ``out/campaign.json``, or check that the one there matches ``plan``. True if it existed."""
     path = out / MANIFEST
     new = plan.manifest()
-    if not path.exists():
-        if (out / RUNS).exists():
+    if not os.path.lexists(path):
+        if os.path.lexists(out / RUNS):
             raise CampaignError(f"--out {out}: has a {RUNS} but no {MANIFEST}; use an empty folder")
         atomic_write_text(path, canonical_json(new))
         return False
     try:
-        old = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise CampaignError(f"--out {out}: {MANIFEST} is not readable ({exc})") from None
-    if not isinstance(old, dict):
-        raise CampaignError(f"--out {out}: {MANIFEST} is not a campaign manifest")
-    diff = manifest_difference(old, new)
+        raw = read_input_bytes(path, follow=False)
+    except InputFileError as exc:
+        raise CampaignError(f"{path}: {exc.problem}") from None
+    try:
+        old = Manifest.model_validate_json(raw, strict=True)
+    except ValidationError as exc:
+        raise CampaignError(f"{path}: not a campaign manifest: {validation_problem(exc)}") from None
+    key = duplicate_json_key(raw)
+    if key is not None:
+        raise CampaignError(f"{path}: not a campaign manifest: the key {key[:60]!r} appears twice in one object")
+    diff = manifest_difference(old.model_dump(mode="json"), new)
     if diff is not None:
         raise CampaignError(f"--out {out} holds a campaign with other options: {diff} "
                             f"(resume with the same options, or use another --out)")

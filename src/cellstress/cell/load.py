@@ -15,6 +15,7 @@ from pathlib import Path
 import yaml
 from pydantic import BaseModel, ValidationError
 
+from cellstress.cell.files import cell_files, refuse_files_outside
 from cellstress.cell.program import robot_program
 from cellstress.cell.robot_stop import robot_stop
 from cellstress.cell.schema import CRITERIA, DEVICE_KINDS, CellSpec
@@ -23,6 +24,7 @@ from cellstress.core.errors import CellError, CellstressError
 from cellstress.core.io import MAX_INPUT_BYTES, InputFileError, read_input_bytes
 from cellstress.core.plane import point_segment_distance, polygon_distance
 from cellstress.core.protocols import Channels
+from cellstress.core.provenance import InputFile
 from cellstress.core.records import Channel
 from cellstress.devices.base import stops_of
 from cellstress.human.body import BODY_RADIUS, WALK_BLOCK_HEIGHT
@@ -46,6 +48,7 @@ class Cell:
     source: str  # the built-in name or the path as given
     directory: Path | None  # folder for relative paths in the file (None for built-ins)
     sha256: str
+    files: tuple[InputFile, ...] = ()  # every file the cell reads, with its size and SHA-256 (cell.files)
 
     @property
     def name(self) -> str:
@@ -318,7 +321,7 @@ def parse_cell(text: str, source: str, directory: Path | None) -> Cell:
         raise CellError(source, field, msg + more) from None
     cell = Cell(spec, source, directory, hashlib.sha256(text.encode()).hexdigest())
     check_geometry(cell)
-    return cell
+    return replace(cell, files=cell_files(cell, text))
 
 
 def load_cell(name_or_path: str | Path) -> Cell:
@@ -350,17 +353,19 @@ def check_geometry(cell: Cell) -> None:
     position and velocity limits, the robot's cycle time, the robots' names and the devices' ``stops``, the start
     pose and every named start point."""
     spec = cell.spec
+    refuse_files_outside(cell)
     several = "robots" in spec.model_fields_set  # a robots list, even of one: its errors name robots[i]
-    for i, rs in enumerate(spec.robots):
-        _check_robot(cell, rs, f"robots[{i}]" if several else "robot")
+    cycles = [_check_robot(cell, rs, f"robots[{i}]" if several else "robot") for i, rs in enumerate(spec.robots)]
     _check_robot_names(cell)
+    _check_clock_windows(cell, cycles[0])
     _check_standing_point(cell, "human.start.xy", spec.human.start.xy)
     for i, s in enumerate(spec.human.starts):
         _check_standing_point(cell, f"human.starts[{i}].xy", s.xy)
 
 
-def _check_robot(cell: Cell, rs, where: str) -> None:
-    """One robot's URDF, program and capsules; errors name ``where`` (robot, or robots[i]) as the field."""
+def _check_robot(cell: Cell, rs, where: str) -> float:
+    """One robot's URDF, program and capsules; errors name ``where`` (robot, or robots[i]) as the field. Returns
+    the program's cycle time [s]."""
     src = cell.source
     urdf = resolve_urdf(rs.urdf, cell.files_dir)
     if not urdf.is_file():
@@ -388,6 +393,24 @@ def _check_robot(cell: Cell, rs, where: str) -> None:
                      else f"{where}.extra_capsules[{i - len(caps)}].link")
             raise CellError(src, field, f"the robot has no link {c.link!r}; its links are "
                                         f"{', '.join(sorted(robot.link_joint))}")
+    return float(traj.cycle)
+
+
+def _check_clock_windows(cell: Cell, cycle: float) -> None:
+    """A muting window runs on the cell's clock, (phase + t) modulo the first robot's cycle: it must start
+    within the cycle and last no longer than one (a window of 500 s on a 2.4 s cycle describes nothing real)."""
+    for i, d in enumerate(cell.spec.devices):
+        field = f"devices[{i}]" + (".muting" if "muting" in type(d).model_fields else "")
+        for c in _channels(d):
+            if c.muted is None:
+                continue
+            start, until = (float(x) for x in c.muted)
+            if start >= cycle:
+                raise CellError(cell.source, field, f"the muting starts at {start:g} s, after the robot's cycle "
+                                f"of {cycle:.3f} s has ended (times are of the cell's clock: 0 up to the cycle time)")
+            if until - start > cycle + 1e-9:
+                raise CellError(cell.source, field, f"the muting lasts {until - start:g} s ({start:g} to {until:g} "
+                                f"s of the cell's clock), longer than the robot's cycle of {cycle:.3f} s")
 
 
 def _check_shapes(cell: Cell, rs, where: str, urdf: Path, robot) -> None:

@@ -163,7 +163,7 @@ def file_program(src: str, jmap: JointMap, spec: RobotSpec, directory: Path | No
     within the velocity limits."""
     task, robot = spec.task, jmap.robot
     field = "robot.task.trajectory_csv"
-    path = _relative(task.trajectory_csv, directory)
+    path = trajectory_path(task.trajectory_csv, directory)
     try:
         jf = read_joint_file(path, jmap.driven_names)
     except JointFileError as exc:
@@ -195,7 +195,8 @@ def _column(robot: RobotModel, header_of: dict[int, int], j: int) -> str:
     return f", column {header_of[source]} ({robot.joint_names[source]})" if source in header_of else ""
 
 
-def _relative(ref: str, directory: Path | None) -> Path:
+def trajectory_path(ref: str, directory: Path | None) -> Path:
+    """The file ``trajectory_csv`` names: relative paths from the cell file's folder."""
     path = Path(ref).expanduser()
     return directory / path if not path.is_absolute() and directory is not None else path
 

@@ -34,6 +34,7 @@ def check(
     out(f"cell        {spec.name}  ({where}, sha256 {c.sha256[:12]})")
     if spec.description:
         out(f"            {first_sentence(spec.description)}")
+    _file_lines(c)
     for part, audit in zip(layout.robots, audits, strict=True):
         _robot_lines(part, c.files_dir, len(layout.robots) > 1)
         out("robot audit " + "\n            ".join(audit.lines(part.model.joint_names)))
@@ -66,6 +67,19 @@ def check(
     else:
         out(f"FAIL: the cell file is valid, the static check fails ({', '.join(static.failures())})")
         raise typer.Exit(1)
+
+
+def _file_lines(c) -> None:
+    """Every file the cell reads, with its size and SHA-256 (result files record them, replay compares them);
+    those outside the cell's folder (and the robots shipped with cellstress and example-robot-data) marked."""
+    from cellstress.cell.files import CONFINE_VAR, outside_paths
+
+    outside = outside_paths(c)
+    note = f"; {len(outside)} outside the cell's folder ({CONFINE_VAR}=inside refuses them)" if outside else ""
+    say(f"files       {len(c.files)} read{note}")
+    for f in c.files:
+        mark = "  OUTSIDE the cell's folder" if f.path in outside else ""
+        say(f"            {f.use:<24} {f.path}  ({f.bytes:,} bytes, sha256 {f.sha256}){mark}")
 
 
 def _robot_lines(part, files_dir, several: bool) -> None:

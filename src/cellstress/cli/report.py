@@ -36,7 +36,8 @@ def report(
     say(f"          {', '.join(p.name for p in files.paths[:-1])} in {folder}")
     say(f"account   {files.account.headline}")
     if files.cell_changed:
-        say("warning   the cell file has changed since the search; the pictures show the current cell")
+        say("warning   the cell file, or a file it reads, has changed since the search (cellstress replay names it); "
+            "the pictures show the current cell")
 
 
 def show(

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 from typing import Annotated
 
 import typer
@@ -27,10 +26,13 @@ def verify(
     phases: Annotated[str, typer.Option("--phases", help="all: every arrival phase of the robot's cycle on the "
                                         "time-step grid; cell: only the phases the cell's "
                                         "human.arrival allows.")] = "all",
+    moments: Annotated[str, typer.Option("--moments", help="all: each grid phase also stands for every arrival "
+                                         "moment within half a time step of it, where the cell allows the argument "
+                                         "(docs/verify.md); grid: the grid moments alone (faster).")] = "all",
     time_limit: Annotated[float | None, typer.Option("--time-limit", help="Seconds; what is not decided by "
                                                      "then is reported as undecided (exit code 3).")] = None,
     workers: Annotated[int | None, typer.Option("--workers", help="Processes deciding sub-trees in parallel "
-                                                "(default: all cores).")] = None,
+                                                "(default: all usable cores; at most 4 per core).")] = None,
     criterion: Annotated[str | None, typer.Option("--criterion", help=criterion_help("the cell file's"))] = None,
 ) -> None:
     """Decide exactly whether any sequence of the worker's actions reaches the unsafe set: every sequence, from
@@ -44,6 +46,7 @@ def verify(
     from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
     from cellstress.cell.load import load_cell, with_criterion
+    from cellstress.core.cpus import check_workers, usable_cpus
     from cellstress.report.scope import judged_by
     from cellstress.report.verify import HTML_NAME, PNG_NAME, hazard_map, summary_lines, verify_page
     from cellstress.sim.simulator import Simulator
@@ -51,6 +54,7 @@ def verify(
 
     with user_errors():
         check_criterion(criterion)
+        check_workers(workers)
     out_dir = check_out_dir(out)
     console = Console(stderr=True)
     bar = Progress(SpinnerColumn(), TextColumn("[bold]deciding"), BarColumn(),
@@ -65,8 +69,8 @@ def verify(
     try:
         with bar, user_errors():
             sim = Simulator(with_criterion(load_cell(cell), criterion))
-            res = verify_cell(sim, horizon=horizon, phases=phases, time_limit=time_limit,
-                              workers=os.cpu_count() or 1 if workers is None else workers, out=out_dir,
+            res = verify_cell(sim, horizon=horizon, phases=phases, moments=moments, time_limit=time_limit,
+                              workers=usable_cpus() if workers is None else workers, out=out_dir,
                               progress=tick)
     except KeyboardInterrupt:
         say("interrupted: nothing was decided (run the same command again)", err=True)

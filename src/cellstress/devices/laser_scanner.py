@@ -16,10 +16,11 @@ from __future__ import annotations
 
 from typing import Annotated, ClassVar, Literal
 
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from cellstress.core.fields import Polygon, PositiveTime, Record
 from cellstress.core.iso13855 import K_WALK, MIN_C_BODY, mm
+from cellstress.core.plane import polygon_outside_point
 from cellstress.core.records import Channel, IsoDistance, ScanPlane
 from cellstress.devices.base import DeviceRecord, Restart
 
@@ -61,6 +62,17 @@ class LaserScanner(DeviceRecord):
 
     detection_phrase: ClassVar[str] = "walks into the field of the laser scanner"
     color: ClassVar[str] = "#f2c300"
+
+    @model_validator(mode="after")
+    def _warning_around_protective(self) -> LaserScanner:
+        # the protective field's distance counts on the reduced speed having taken effect when the worker reaches
+        # it (module docstring): only true if the worker crosses the warning field first, everywhere
+        if self.warning is not None:
+            p = polygon_outside_point(self.polygon, self.warning.polygon)
+            if p is not None:
+                raise ValueError(f"warning.polygon must contain the protective field (polygon): the protective "
+                                 f"field's point ({p[0]:.3f}, {p[1]:.3f}) lies outside the warning field")
+        return self
 
     def primitives(self) -> tuple[ScanPlane, ...]:
         return (ScanPlane(tuple(self.polygon), self.height),)

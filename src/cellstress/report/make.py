@@ -10,6 +10,7 @@ from pathlib import Path
 from cellstress.analysis.iso13855 import check_cell
 from cellstress.analysis.shortfall import shortfall
 from cellstress.core.errors import CellstressError
+from cellstress.core.provenance import file_changes
 from cellstress.report import draw as D
 from cellstress.report import html as H
 from cellstress.report.animate import AnimationOptions, animate
@@ -42,7 +43,7 @@ class ReportFiles:
     html: Path
     account: Account
     found: bool
-    cell_changed: bool  # the cell file differs from the one searched (sha256)
+    cell_changed: bool  # the cell file, or a file it reads, differs from the one searched (sha256)
 
     @property
     def paths(self) -> tuple[Path, ...]:
@@ -93,7 +94,8 @@ def write_report(result: SearchResult | str | Path, out_dir: str | Path | None =
     risk = D.save_png(risk_figure(res.risk_per_episode, h.episode if h else None, st.risk, title,
                                   tuple(e.episode for e in res.hazards)), out / NAMES[3])
     acc = account(view, res.episodes)
-    changed = sim.cell.sha256 != res.cell.sha256
+    changed = sim.cell.sha256 != res.cell.sha256 or (  # or a file it reads (a URDF, a mesh; issue 29)
+        res.cell.files is not None and bool(file_changes(res.cell.files, sim.cell.files)))
     strongest = None if res.found else strongest_contact(sim, view.actions)
     why = None if not res.found or res.hazard.why is None else shortfall(res.hazard.why, check_cell(sim.cell))
     page = hazard_page(res, view, acc, top, contact, gif, risk, changed, Judgement(
@@ -162,8 +164,9 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
                     f"Searched: {e(judgement.scope)}.<br>{e(NOT_A_PROOF)}<br>The riskiest episode kept "
                     f"(episode {view.episode}) is shown instead.{strongest}</div>")
     if cell_changed:
-        body.append('<p class="warn">The cell file has changed since the search (sha256 differs): the pictures '
-                    "show the episode replayed in the current cell.</p>")
+        body.append('<p class="warn">The cell file, or a file it reads, has changed since the search (sha256 '
+                    "differs; cellstress replay names it): the pictures show the episode replayed in the current "
+                    "cell.</p>")
     if view.matches_file is False:
         body.append('<p class="warn">The replay does not agree bit-exactly with the trace in result.json.</p>')
     body.append("<h2>What happens</h2>")

@@ -77,17 +77,31 @@ def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None
     ]
     for p in res.pruned:
         lines.append(f"pruned    {p.bound}: {p.states:,} states, {p.sequences:,} sequences proved safe")
-    scope = (f"within this worker model (30 actions, {o.horizon} per episode), {res.dt:g} s steps, positions merged "
-             f"within {res.merge_xy * 1e6:g} um and angles within {res.merge_angle:g} rad, and this criterion")
+    sc = res.scope
+    where = f"from start point{'s' if len(sc.starts) > 1 else ''} {', '.join(sc.starts)}, at {sc.arrival}"
     if res.verdict == PROVED_SAFE:
-        lines.append(f"PROVED-SAFE: no sequence reaches the unsafe set from any start point at any arrival phase "
-                     f"decided ({scope})")
+        lines.append(f"PROVED-SAFE: no sequence of {o.horizon} actions reaches the unsafe set {where}")
     elif res.verdict == UNDECIDED:
-        lines.append(f"UNDECIDED: {res.undecided:,} sequences were not decided (time limit); no hazard among the "
-                     f"rest; this is not a proof")
-    else:
-        lines.append(f"UNSAFE: {res.hazardous:,} of {res.sequences:,} sequences hazardous "
+        why = []
+        if res.undecided:
+            why.append(f"{res.undecided:,} sequences were not decided (time limit)")
+        if res.alarms:
+            why.append(f"{res.alarms:,} sequences touch the robot grown by its arrival margin but are hazardous at "
+                       "none of the arrival moments replayed across their window (alarms, listed below)")
+        lines.append(f"UNDECIDED: {'; '.join(why)}; no hazard among the rest; this is not a proof")
+    elif res.hazardous:
+        lines.append(f"UNSAFE: {res.hazardous:,} of {res.sequences:,} sequences hazardous at the grid moments "
                      f"(p = {res.hazardous / res.sequences:.3e} for a uniformly random worker)")
+    else:
+        confirmed = sum(s.confirmed for s in res.subtrees)
+        lines.append(f"UNSAFE: none hazardous at the grid moments, but {confirmed:,} sequences are at arrival "
+                     "moments between them (replayed; their witnesses below)")
+    if sc.horizon < sc.cell_horizon:
+        lines.append(f"note      {sc.horizon} actions per episode, fewer than the cell's own {sc.cell_horizon}: "
+                     "contacts after them are not decided")
+    for a in sc.approximations:
+        size = f" ({a.size:.3g} {a.unit})" if a.size else ""
+        lines.append(f"model     {a.name}{size}: {a.what}")
     hazardous = [s for s in res.subtrees if s.hazardous]
     for s in hazardous[:MAX_LISTED]:
         lines.append(f"  {s.start} at phase {s.phase:g} s: {s.hazardous:,} of {s.sequences:,} hazardous "
@@ -96,9 +110,19 @@ def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None
         worst = max(hazardous, key=lambda s: s.hazardous)
         lines.append(f"  ... {len(hazardous) - MAX_LISTED} more hazardous sub-trees (verify.json, verify.html); the "
                      f"most: {worst.start} at phase {worst.phase:g} s (p = {worst.probability:.3e})")
+    between = [s for s in res.subtrees if s.confirmed and not s.hazardous]
+    for s in between[:MAX_LISTED]:
+        lines.append(f"  {s.start} within {s.window:g} s of phase {s.phase:g} s: {s.confirmed:,} sequences hazardous "
+                     "at an arrival moment between grid points (replayed)")
     undecided = [s for s in res.subtrees if s.undecided]
-    for s in undecided:
+    for s in undecided[:MAX_LISTED]:
         lines.append(f"  undecided: {s.start} at phase {s.phase:g} s ({s.undecided:,} sequences)")
+    alarmed = [s for s in res.subtrees if s.alarms]
+    for s in alarmed[:MAX_LISTED]:
+        lines.append(f"  alarm: {s.start} within {s.window:g} s of phase {s.phase:g} s: {s.alarms:,} sequences touch "
+                     f"the robot grown by up to {s.margin * 1000:.0f} mm, none hazardous when replayed")
+    if len(undecided) + len(alarmed) > 2 * MAX_LISTED:
+        lines.append("  ... more in verify.json")
     for i, w in enumerate(res.classes, start=1):
         k = w.klass
         failed = "no device saw the worker" if k.device == "none" else f"{k.device} stopped the robot too late"
@@ -120,13 +144,19 @@ def verify_page(res: VerifyResult, png: str | Path, path: str | Path, criterion_
     body = [f"<h1>{escape(res.cell.name)}: {escape(res.verdict)}</h1>",
             f'<div class="verdict {"safe" if res.verdict == PROVED_SAFE else "hazard"}">{escape(verdict)}</div>',
             H.table(None, [[ln.split(" ", 1)[0], ln.split(" ", 1)[1].strip()] for ln in lines[:3 + len(res.pruned)]]),
+            f"<p>{escape(res.scope.statement)}</p>",
+            H.table(["approximation", "size", "what"],
+                    [[a.name, f"{a.size:.3g} {a.unit}" if a.size else "", a.what]
+                     for a in res.scope.approximations]),
             H.figure(png, "Hazard map: arrival phases x start points", "hazard map"),
             "<h2>Sub-trees</h2>",
-            H.table(["start", "phase [s]", "verdict", "hazardous", "of", "P(hazard)", "undecided", "states"],
+            H.table(["start", "phase [s]", "verdict", "hazardous", "of", "P(hazard)", "between grid moments",
+                     "alarms", "undecided", "states"],
                     [[s.start, f"{s.phase:g}", s.verdict, f"{s.hazardous:,}", f"{s.sequences:,}",
-                      f"{s.probability:.3e}", f"{s.undecided:,}", f"{sum(s.states):,}"] for s in res.subtrees
-                     if s.verdict != PROVED_SAFE] or [["(every sub-tree proved safe)", "", "", "", "", "", "", ""]],
-                    numeric={1, 3, 4, 5, 6, 7})]
+                      f"{s.probability:.3e}", f"{s.confirmed:,}", f"{s.alarms:,}", f"{s.undecided:,}",
+                      f"{sum(s.states):,}"] for s in res.subtrees if s.verdict != PROVED_SAFE]
+                    or [["(every sub-tree proved safe)", "", "", "", "", "", "", "", "", ""]],
+                    numeric={1, 3, 4, 5, 6, 7, 8, 9})]
     if res.classes:  # worst first (searchers.severity)
         body += ["<h2>Hazard classes and their witnesses</h2>",
                  H.table(["class", "device", "robot link / body region", "severity", "sequences", "witness",

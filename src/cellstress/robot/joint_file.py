@@ -1,7 +1,8 @@
 """A joint-trajectory file: CSV with a header ``time,q1,...,qn`` (or the joint names) and a row per sample.
 
 The file is untrusted: its size and row count are bounded before anything is parsed, and every bad value is
-one error naming its row (the header is row 1, so a row is its line) and its column.
+one error naming its row (the header is row 1, so a row is its line) and its column. An error never quotes the
+file's text: a cell may name any file (``/etc/passwd``), and its first line must not end up in a log.
 """
 
 from __future__ import annotations
@@ -47,22 +48,28 @@ def read_joint_file(path: Path, joint_names: tuple[str, ...]) -> JointFile:
     except UnicodeDecodeError as exc:
         line = raw[: exc.start].count(b"\n") + 1
         raise JointFileError(f"row {line}", "is not UTF-8 text") from None
-    if text.count("\n") > MAX_ROWS + 1:
+    text = text.replace("\r\n", "\n").replace("\r", "\n")  # a row ends at any of the three line ends
+    # header + MAX_ROWS rows, the last one with or without its newline (the loop below counts them again)
+    if text.count("\n") + (not text.endswith("\n")) > MAX_ROWS + 1:
         raise JointFileError("", f"has more than {MAX_ROWS:,} rows")
     rows = csv.reader(io.StringIO(text))
     try:
         header = [h.strip() for h in next(rows)]
-    except (StopIteration, csv.Error):
+    except StopIteration:
         raise JointFileError("row 1", "the file is empty; it needs a header 'time,q1,...'") from None
+    except csv.Error as exc:
+        raise JointFileError("row 1", f"not valid CSV ({exc})") from None
     n = len(joint_names)
     numbered = ["time", *(f"q{i + 1}" for i in range(n))]
     named = ["time", *joint_names]
     if header not in (numbered, named):
         raise JointFileError("row 1", f"the header must be {','.join(numbered)} or {','.join(named)} "
-                                      f"(the program drives {n} joints); got {','.join(header)[:200]}")
+                                      f"(the program drives {n} joints); {_header_problem(header, numbered, named)}")
     times, values = [], []
     try:
         for r, row in enumerate(rows, start=2):
+            if r - 1 > MAX_ROWS:
+                raise JointFileError("", f"has more than {MAX_ROWS:,} rows")
             if not row or all(not c.strip() for c in row):
                 continue
             if len(row) != n + 1:
@@ -80,13 +87,20 @@ def read_joint_file(path: Path, joint_names: tuple[str, ...]) -> JointFile:
     return JointFile(np.asarray(times), np.asarray(values, dtype=float).reshape(len(times), n))
 
 
+def _header_problem(header: list[str], numbered: list[str], named: list[str]) -> str:
+    """What is wrong with the header, by column number: never the file's own words."""
+    if len(header) != len(numbered):
+        return f"row 1 has {len(header)} columns, not {len(numbered)}"
+    k = next(k for k, h in enumerate(header) if h not in (numbered[k], named[k]))
+    return f"column {k + 1} should be {numbered[k]} or {named[k]}"
+
+
 def _number(text: str, row: int, col: int, name: str) -> float:
     try:
         x = float(text)
     except ValueError:
-        raise JointFileError(f"row {row}, column {col + 1} ({name})",
-                             f"{text.strip()[:30]!r} is not a number") from None
+        raise JointFileError(f"row {row}, column {col + 1} ({name})", "is not a number") from None
     if not math.isfinite(x) or abs(x) > 1e6:
-        raise JointFileError(f"row {row}, column {col + 1} ({name})", f"{text.strip()[:30]} is not a finite "
-                                                                       "number of sensible size")
+        raise JointFileError(f"row {row}, column {col + 1} ({name})", "is not a finite number of sensible size "
+                                                                       "(at most 1e6 in size)")
     return x

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from cellstress.core import registry
 from cellstress.core.errors import PluginError
+from cellstress.core.io import duplicate_json_key
 from cellstress.core.version import __version__
 from cellstress.searchers.common import (
     UNTIL,
@@ -75,8 +76,11 @@ def parse_options(settings: list[str] | tuple[str, ...] | None, flag: str = "--s
             raise SearchError(f"{flag}: option {name!r} given twice")
         try:
             out[name] = json.loads(text)
-        except ValueError:
+        except (ValueError, RecursionError):
             out[name] = text.strip()
+        dup = duplicate_json_key(text)
+        if dup is not None:
+            raise SearchError(f"{flag} {name}: the key {dup[:60]!r} appears twice in the value")
     return out
 
 
@@ -160,7 +164,7 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
     source = c.source if c.directory is None else str(Path(c.source).expanduser().resolve())
     crit = c.spec.criterion.type
     return SearchResult.model_construct(
-        cell=CellRef.model_construct(name=c.name, sha256=c.sha256, source=source, criterion=crit),
+        cell=CellRef.model_construct(name=c.name, sha256=c.sha256, source=source, criterion=crit, files=c.files),
         searcher=s.name,
         params=asdict(s),
         seed=int(seed),

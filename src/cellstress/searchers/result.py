@@ -19,7 +19,15 @@ from pydantic import ConfigDict, Field, TypeAdapter, ValidationError, model_seri
 
 from cellstress.core import registry
 from cellstress.core.fields import Record
-from cellstress.core.io import InputFileError, canonical_json, json_ready, read_input_bytes, write_in_folder
+from cellstress.core.io import (
+    InputFileError,
+    canonical_json,
+    duplicate_json_key,
+    json_ready,
+    read_input_bytes,
+    write_in_folder,
+)
+from cellstress.core.provenance import InputFiles
 from cellstress.searchers.common import UNTIL, SearchError
 from cellstress.sim.records import Name, StepRecord
 
@@ -40,13 +48,22 @@ VERDICT = TypeAdapter(dict[Name, bool | int | float | Annotated[str, Field(max_l
 
 class CellRef(Record):
     """The cell searched: its name, the sha256 of its file's text, where it came from (a built-in name or an
-    absolute path), and the criterion it was judged by (absent from early files: the default,
-    contact-while-moving)."""
+    absolute path), the criterion it was judged by (absent from early files: the default,
+    contact-while-moving) and every file it read, with size and sha256 (``cell.files``; absent from files
+    written before issue 29)."""
 
     name: Name
     sha256: Annotated[str, Field(pattern=r"^[0-9a-f]{64}$")]
     source: Annotated[str, Field(max_length=4096)]
     criterion: Name | None = None
+    files: InputFiles | None = None
+
+    @model_serializer(mode="wrap")
+    def _drop_absent(self, handler):
+        out = handler(self)
+        if out.get("files") is None:
+            out.pop("files", None)
+        return out
 
 
 class HazardClass(Record):
@@ -216,6 +233,27 @@ class SearchResult(Record):
     # contacts last; ties in the order found: searchers.severity)
     distinct: Annotated[tuple[DistinctHazard, ...], Field(max_length=MAX_LISTED)] | None = None
 
+    @model_validator(mode="after")
+    def _agrees_with_its_budget(self) -> SearchResult:
+        # a file from elsewhere: every list is one entry per episode played, or a few of those episodes, so a
+        # file claiming 40 episodes cannot carry 600,000 risks (issue 29); each message names its field. Claims
+        # that are merely false (which episode found the hazard, whether one was found) are replay's to refute.
+        n = self.episodes
+        if n > self.budget:
+            raise ValueError(f"episodes: {n:,} played, more than the budget of {self.budget:,}")
+        if len(self.risk_per_episode) != n:
+            raise ValueError(f"risk_per_episode: lists {len(self.risk_per_episode):,} values for {n:,} episodes "
+                             "(one per episode played)")
+        if self.distinct_sequences is not None and self.distinct_sequences > n:
+            raise ValueError(f"distinct_sequences: {self.distinct_sequences:,}, more than the {n:,} episodes")
+        for field, items in (("hazards", self.hazards), ("top", self.top), ("distinct", self.distinct or ())):
+            if len(items) > n:
+                raise ValueError(f"{field}: lists {len(items):,} episodes of {n:,}")
+            for i, e in enumerate(items):
+                if e.episode > n:
+                    raise ValueError(f"{field}[{i}].episode: episode {e.episode:,} of {n:,}")
+        return self
+
     def to_dict(self) -> dict[str, Any]:
         doc = self.model_dump(by_alias=True)
         for key in ("distinct", "distinct_sequences"):
@@ -235,9 +273,10 @@ class SearchResult(Record):
     def to_json(self) -> str:
         return canonical_json(self.to_dict())
 
-    def write(self, out_dir: str | Path) -> Path:
-        """Write ``out_dir/result.json`` atomically; returns its path."""
-        return write_in_folder(out_dir, FILE_NAME, self.to_json())
+    def write(self, out_dir: str | Path, *, inside: str | Path | None = None) -> Path:
+        """Write ``out_dir/result.json`` atomically; returns its path. ``inside``: the output folder the user
+        chose, when ``out_dir`` is a folder of ours within it (``core.io.write_in_folder``)."""
+        return write_in_folder(out_dir, FILE_NAME, self.to_json(), inside=inside)
 
     @classmethod
     def load(cls, path: str | Path) -> SearchResult:
@@ -252,14 +291,18 @@ class SearchResult(Record):
             problem = "no such result file" if exc.problem == "no such file" else exc.problem
             raise SearchError(f"{p}: {problem}") from None
         try:
-            return cls.model_validate_json(raw, strict=True)
+            res = cls.model_validate_json(raw, strict=True)
         except ValidationError as exc:
-            raise SearchError(f"{p}: not a cellstress result file: {_problem(exc)}") from None
+            raise SearchError(f"{p}: not a cellstress result file: {validation_problem(exc)}") from None
+        key = duplicate_json_key(raw)
+        if key is not None:
+            raise SearchError(f"{p}: not a cellstress result file: the key {key[:60]!r} appears twice in one object")
+        return res
 
 
-def _problem(exc: ValidationError) -> str:
+def validation_problem(exc: ValidationError) -> str:
     """The first problem of a validation error in one line: the field's path and what is wrong (the value is
-    never echoed whole: it may be huge or hostile)."""
+    never echoed whole: it may be huge or hostile). A check of the whole record names its field itself."""
     errors = exc.errors(include_input=False, include_url=False)
     e = errors[0]
     where = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in e["loc"]).lstrip(".") or "(top level)"
@@ -268,4 +311,6 @@ def _problem(exc: ValidationError) -> str:
         msg = f"invalid JSON ({e.get('ctx', {}).get('error', 'malformed')})"
         where = "(file)"
     more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
+    if e["type"] == "value_error" and not e["loc"]:
+        return f"{msg.removeprefix('Value error, ')[:300]}{more}"
     return f"{where}: {msg[:200]}{more}"

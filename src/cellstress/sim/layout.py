@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from cellstress.core.records import MAX_DOORS
-from cellstress.core.vector_spec import VectorSpec
+from cellstress.core.vector_spec import EXACT, Merge, StateSpec, VectorSpec
 from cellstress.human.actions import (  # noqa: F401  (re-exported: the action table's columns)
     A_DIR,
     A_DROP,
@@ -65,54 +65,69 @@ _SEP_SLOTS = tuple(f"SEP_Q{i}" for i in range(1, SEP_QUEUE))  # (the kernels ind
 _ARM_SLOTS = tuple(f"ARM{k}_Q{j}" for k in range(2) for j in range(5))
 _DOOR_SLOTS = tuple(f"DOOR{i}_{what}" for what in ("REQ", "OPEN") for i in range(MAX_DOORS))
 
-STATE = VectorSpec("state vector (a snapshot is a copy of it)", (
-    ("K", "time step k (a float): the state's time is k * dt"),
-    ("X", "worker's position on the floor, x [m]"),
-    ("Y", "worker's position on the floor, y [m]"),
-    ("HEADING", "worker's heading [rad], counter-clockwise from +x"),
-    ("FWD", "trunk forward flexion [rad]"),
-    ("LAT", "trunk lateral flexion [rad]"),
-    ("TSTOP", "time the robot's latched stop takes effect [s]; inf: none latched"),
-    ("TRIG_DEV", "device whose detection set TSTOP; -1: none"),
-    ("TRIG_T", "time of the first detection [s]; -1: none"),
-    ("UNSAFE", "1 once a step was unsafe: the episode has ended and the state no longer moves"),
-    ("ACTIONS", "actions played so far"),
+# How each state slot merges in verify (core.vector_spec.Merge): bit for bit, or not at all where nothing that
+# decides the future reads it (each such slot says why).
+_RECORD = "a record for the reports, written by the kernels and read by nothing that moves the worker or the " \
+          "robot, senses, or judges a step"
+
+STATE = StateSpec.of("state vector (a snapshot is a copy of it)", (
+    ("K", "time step k (a float): the state's time is k * dt", EXACT),
+    ("X", "worker's position on the floor, x [m]", EXACT),
+    ("Y", "worker's position on the floor, y [m]", EXACT),
+    ("HEADING", "worker's heading [rad], counter-clockwise from +x", EXACT),
+    ("FWD", "trunk forward flexion [rad]", EXACT),
+    ("LAT", "trunk lateral flexion [rad]", EXACT),
+    ("TSTOP", "time the robot's latched stop takes effect [s]; inf: none latched", EXACT),
+    ("TRIG_DEV", "device whose detection set TSTOP; -1: none (exact: it names a hazard's class)", EXACT),
+    ("TRIG_T", "time of the first detection [s]; -1: none",
+     Merge("free", reason="written when the first stop latches, read only to keep that first time; " + _RECORD)),
+    ("UNSAFE", "1 once a step was unsafe: the episode has ended and the state no longer moves", EXACT),
+    ("ACTIONS", "actions played so far", EXACT),
     # safeguards (issue 18): restart and speed reduction; appended, so the slots above never move
     ("LIVE", "1 once a stop was released or a speed reduction latched: the robot is computed live from the "
-             "anchor below (0: path time = phase + t until TSTOP, the pre-stop table)"),
-    ("A_T", "anchor: time of the last release [s] (0 at reset)"),
-    ("A_TAU", "anchor: path time at A_T, less the cell's phase [s]"),
-    ("A_SIG", "anchor: time scaling dtau/dt at A_T"),
-    ("A_TGT", "anchor: time scaling the path ramps to after A_T (at 1 / stopping time per second)"),
-    ("TSLOW", "time the latched speed reduction takes effect [s]; inf: none latched"),
-    ("SLOW", "the latched reduction's time scaling (a warning field's reduced_speed)"),
-    ("STOP_SEEN", "last time a stopping device saw the worker [s]; -1: never"),
+             "anchor below (0: path time = phase + t until TSTOP, the pre-stop table)", EXACT),
+    ("A_T", "anchor: time of the last release [s] (0 at reset)", EXACT),
+    ("A_TAU", "anchor: path time at A_T, less the cell's phase [s]", EXACT),
+    ("A_SIG", "anchor: time scaling dtau/dt at A_T", EXACT),
+    ("A_TGT", "anchor: time scaling the path ramps to after A_T (at 1 / stopping time per second)", EXACT),
+    ("TSLOW", "time the latched speed reduction takes effect [s]; inf: none latched", EXACT),
+    ("SLOW", "the latched reduction's time scaling (a warning field's reduced_speed)", EXACT),
+    ("STOP_SEEN", "last time a stopping device saw the worker [s]; -1: never",
+     Merge("exact", reason="read only by the automatic release (t - STOP_SEEN >= STOP_CLEAR), which never "
+                           "happens while STOP_CLEAR is inf; the next stop that latches writes it anew",
+           free_while="STOP_CLEAR", free_value=float("inf"))),
     ("STOP_CLEAR", "clear time [s] the latched stop waits for: the longest automatic restart time of the devices "
-                   "that saw the worker since it latched; inf: one of them restarts manually, or none latched"),
-    ("SLOW_SEEN", "last time a warning field saw the worker [s]; -1: never"),
-    ("SLOW_CLEAR", "the same for the latched speed reduction"),
-    ("RESTARTS", "stops released so far"),
+                   "that saw the worker since it latched; inf: one of them restarts manually, or none latched",
+     EXACT),
+    ("SLOW_SEEN", "last time a warning field saw the worker [s]; -1: never",
+     Merge("exact", reason="read only by the release of the speed reduction, which never happens while "
+                           "SLOW_CLEAR is inf; the next warning writes it anew",
+           free_while="SLOW_CLEAR", free_value=float("inf"))),
+    ("SLOW_CLEAR", "the same for the latched speed reduction", EXACT),
+    ("RESTARTS", "stops released so far", Merge("free", reason="a counter for the reports; " + _RECORD)),
     # interlocked guard doors (issue 18): two slots per door, MAX_DOORS doors, in the order of SimParams.door_dev
     *((f"DOOR{i}_REQ", f"guard door {i}: time the worker first pushed it [s] (its interlock's stop request); "
-                       "inf: not yet") for i in range(MAX_DOORS)),
+                       "inf: not yet", EXACT) for i in range(MAX_DOORS)),
     *((f"DOOR{i}_OPEN", f"guard door {i}: time it started to open [s] (with guard locking: once the robot was "
-                        "at rest); passable from this time plus its opening time; inf: closed")
+                        "at rest); passable from this time plus its opening time; inf: closed", EXACT)
       for i in range(MAX_DOORS)),
     # several robots: robot 0's stop is TSTOP above; robots 1..3 latch their own (appended: nothing above moves)
-    ("XTSTOP1", "time robot 1's latched stop takes effect [s]; inf: none latched (or no such robot)"),
-    ("XTSTOP2", "the same for robot 2"),
-    ("XTSTOP3", "the same for robot 3"),
+    ("XTSTOP1", "time robot 1's latched stop takes effect [s]; inf: none latched (or no such robot)", EXACT),
+    ("XTSTOP2", "the same for robot 2", EXACT),
+    ("XTSTOP3", "the same for robot 3", EXACT),
     # speed and separation monitoring (issue 18): the speed commands; appended, so the slots above never move
-    ("SEP_ON", "the speed fraction the separation monitor's command in effect allows (1 at reset)"),
+    ("SEP_ON", "the speed fraction the separation monitor's command in effect allows (1 at reset)", EXACT),
     *((f"SEP_Q{i}", f"the fraction commanded at a step k with k mod {SEP_QUEUE} = {i} (in flight until k dt + the "
-                    "response time); -1: none") for i in range(SEP_QUEUE)),
-    ("SEP_LOW", "the lowest fraction commanded so far (1: none below full speed)"),
-    ("SEP_LOW_T", "time of the measurement that commanded SEP_LOW [s]; -1: none"),
-    ("SEP_LOW_S", "the separation measured then [m]; -1: none"),
+                    "response time); -1: none", EXACT) for i in range(SEP_QUEUE)),
+    ("SEP_LOW", "the lowest fraction commanded so far (1: none below full speed)",
+     Merge("free", reason="read only to keep the lowest; " + _RECORD)),
+    ("SEP_LOW_T", "time of the measurement that commanded SEP_LOW [s]; -1: none", Merge("free", reason=_RECORD)),
+    ("SEP_LOW_S", "the separation measured then [m]; -1: none", Merge("free", reason=_RECORD)),
     # the articulated worker (issue 20; appended): its stance and arm joints (0 for the paper's worker)
-    ("DROP", "the hip's height above its standing height [m]: negative crouching or kneeling, positive on tiptoe"),
+    ("DROP", "the hip's height above its standing height [m]: negative crouching or kneeling, positive on tiptoe",
+     EXACT),
     *((f"ARM{k}_Q{j}", f"{side} arm's joint {j} [rad] (human.reach's order: shoulder flexion, abduction, upper-arm "
-                       "rotation, elbow flexion, wrist flexion), relative to the trunk")
+                       "rotation, elbow flexion, wrist flexion), relative to the trunk", EXACT)
       for k, side in enumerate(("left", "right")) for j in range(5)),
 ))
 (S_K, S_X, S_Y, S_HEADING, S_FWD, S_LAT, S_TSTOP, S_TRIG_DEV, S_TRIG_T, S_UNSAFE, S_ACTIONS, S_LIVE, S_A_T, S_A_TAU,
@@ -220,6 +235,9 @@ SCALARS = VectorSpec("scalar parameters (SimParams.scal)", (
     ("VTOL", "robot speed above which a contact is unsafe [m/s]; inf: the kernel judges no contact"),
     ("REACH_ORIGIN", "reach field: coordinate of its first grid node on every axis [m]"),
     ("REACH_H", "reach field: grid spacing [m]"),
+    ("ANY_MOTION", "1: the kernel test's speed condition is that the robot owning the nearest capsule is not at a "
+                   "standstill (stop phase other than STOPPED), whatever v_R (verify's arrival-window model: the "
+                   "robot's speed at arrival moments between grid points is not known there); 0: v_R above VTOL"),
     # how the robot stops (issue 28; appended, so the slots above never move)
     ("STOP_DELAY", "time from a stop's signal (detection plus the device's response) until the robot begins to brake "
                    "[s]: the controller's delay; the latched stop (TSTOP) takes effect after it. 0 for category 0"),
@@ -228,8 +246,8 @@ SCALARS = VectorSpec("scalar parameters (SimParams.scal)", (
                   "within STOP_TIME; 0: it brakes along its path"),
 ))
 (C_DT, C_STOP_TIME, C_PHASE0, C_CYCLE, C_LINEAR, C_DTOL, C_VTOL, C_REACH_ORIGIN, C_REACH_H,
- C_STOP_DELAY, C_STOP_HOLD) = SCALARS.indices(
-    "DT", "STOP_TIME", "PHASE0", "CYCLE", "LINEAR", "DTOL", "VTOL", "REACH_ORIGIN", "REACH_H",
+ C_ANY_MOTION, C_STOP_DELAY, C_STOP_HOLD) = SCALARS.indices(
+    "DT", "STOP_TIME", "PHASE0", "CYCLE", "LINEAR", "DTOL", "VTOL", "REACH_ORIGIN", "REACH_H", "ANY_MOTION",
     "STOP_DELAY", "STOP_HOLD")
 N_SCAL = SCALARS.size
 

@@ -52,3 +52,9 @@ def arrival_phases(sim, start: StartPoint, mode: str = "all") -> tuple[float, ..
         return cell_phases(sim, start.spec)
     cycle = float(sim.layout.trajectory.cycle)
     return tuple(p for p in phase_grid(sim.dt, 0.0, cycle) if p < cycle)  # the cycle's end is its start
+
+
+def phases_are_grid(cell, mode: str) -> bool:
+    """Whether ``mode`` decides the time-step grid of arrival moments (``all``, or a cell whose arrival is
+    searched over its cycle or a window), rather than a cell's fixed moments."""
+    return mode == "all" or cell.spec.human.arrival != "fixed"

@@ -13,8 +13,8 @@ whatever the devices do, the robot's pose is its path's pose at some path time i
 The path is sampled every ``dt / SUB`` of path time; between samples no point of a capsule axis moves more than
 ``speed`` x half the spacing, where ``speed`` bounds every capsule point's speed along the path: the sum over the
 joints that move it of the joint's peak speed (a minimum-jerk segment peaks at 1.875 times its mean speed) times
-the point's distance from the joint's origin (at most the lengths of the links in between plus the capsule's
-end).
+the point's distance from the joint's origin (at most the lengths of the links in between, the slides of the
+prismatic joints in between, and the capsule's end), plus each prismatic joint's own peak speed.
 
 **The field.** For each robot sample, the distance from every node of a floor grid (spacing ``GRID``, at hip
 height) to the sample's capsules, less the sampling allowance and half a grid diagonal: the true distance from
@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from cellstress.core.jit import njit, prange
+from cellstress.robot.model import PRISMATIC
 from cellstress.sim import layout as L
 from cellstress.sim.scene import robot_capsules
 
@@ -48,31 +49,38 @@ def worker_radius(body: np.ndarray, reach_spacing: float) -> float:
                  + REACH_SLACK * reach_spacing)
 
 
-def robot_point_speed(layout) -> float:
-    """An upper bound on the speed of any point of any capsule axis per second of path time (see the module)."""
-    P = layout.params
-    traj = layout.trajectory
+def capsule_speeds(part) -> np.ndarray:
+    """For each capsule of one robot (a ``sim.build.RobotPart``), an upper bound on the speed of any point of its
+    axis per second of path time (see the module)."""
+    model, traj = part.model, part.trajectory
     wp = np.asarray(traj.waypoints)
     moves = np.asarray(traj.move_times, dtype=float)
-    nj = wp.shape[1]
-    qd_max = np.zeros(nj)
+    qd_max = np.zeros(wp.shape[1])
     for i in range(len(wp)):
         step = np.abs(wp[(i + 1) % len(wp)] - wp[i])
         qd_max = np.maximum(qd_max, PEAK * step / moves[i])
-    link = np.linalg.norm(P.placements[:, :3, 3], axis=1)  # joint j's origin from its parent's
-    best = 0.0
-    for c in range(len(P.cap_r)):
-        j = int(P.cap_joint[c])
-        if j < 0:
-            continue  # on the base: it does not move
-        end = max(np.linalg.norm(P.cap_a[c]), np.linalg.norm(P.cap_b[c]))
-        speed, lever, i = 0.0, end, j
+    prismatic = np.asarray([k == PRISMATIC for k in model.kinds])
+    # a move's joint values stay between its two waypoints' (minimum-jerk and linear moves are monotone), so a
+    # prismatic joint's slide is at most its largest waypoint value, and it carries the joints below it that far
+    slide = np.where(prismatic, np.abs(wp).max(axis=0), 0.0)
+    link = np.linalg.norm(np.asarray(model.placements)[:, :3, 3], axis=1)  # from the parent's origin, unslid
+    out = np.zeros(len(part.capsules))
+    for c, cap in enumerate(part.capsules):
+        speed, lever, i = 0.0, max(np.linalg.norm(cap.p0), np.linalg.norm(cap.p1)), int(cap.joint)
         while i >= 0:  # joint i moves the point; its distance from joint i's origin is at most ``lever``
-            speed += qd_max[i] * lever
-            lever += link[i]
-            i = int(P.parents[i])
-        best = max(best, speed)
-    return best
+            if prismatic[i]:
+                speed += qd_max[i]  # a slide moves every point it carries at its own speed
+            else:
+                speed += qd_max[i] * lever  # a turn: at most the point's distance from the axis times the rate
+            lever += link[i] + slide[i]
+            i = int(model.parents[i])
+        out[c] = speed  # (0 for a capsule on the base: joint -1)
+    return out
+
+
+def robot_point_speed(layout) -> float:
+    """An upper bound on the speed of any point of any of robot 0's capsule axes per second of path time."""
+    return float(capsule_speeds(layout.robots[0]).max(initial=0.0))
 
 
 class SweptField:

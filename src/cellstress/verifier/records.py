@@ -14,7 +14,7 @@ from cellstress.core.io import canonical_json, json_ready, write_in_folder
 from cellstress.searchers.result import CellRef, HazardClass, Severity
 from cellstress.sim.records import Name
 
-FORMAT = 1
+FORMAT = 2  # 2: what the verdict covers (scope), arrival windows and their alarms; no merge tolerances
 FILE_NAME = "verify.json"
 PROVED_SAFE, UNSAFE, UNDECIDED = "PROVED-SAFE", "UNSAFE", "UNDECIDED"
 VERDICTS = (PROVED_SAFE, UNSAFE, UNDECIDED)
@@ -25,10 +25,13 @@ Count = Annotated[int, Field(ge=0)]
 
 class VerifyOptions(Record):
     """What to decide: episodes of ``horizon`` actions, at the arrival phases ``phases`` selects
-    (``verifier.phases``), with the pruning ``bounds`` named; ``time_limit`` [s] (None: none)."""
+    (``verifier.phases``), with the pruning ``bounds`` named; ``time_limit`` [s] (None: none). ``moments``:
+    ``all``, each grid phase stands for every arrival moment within half a time step of it where the cell
+    allows the argument (``verifier.arrival``); ``grid``, the grid moments alone."""
 
     horizon: Annotated[int, Field(ge=1, le=12)] = 8
     phases: Literal["all", "cell"] = "all"
+    moments: Literal["all", "grid"] = "all"
     bounds: tuple[Literal["at-rest", "distance"], ...] = ("at-rest", "distance")
     time_limit: Annotated[float, Field(gt=0.0)] | None = None
 
@@ -49,10 +52,18 @@ class ClassCount(Record):
 
 
 class Subtree(Record):
-    """One start point at one arrival phase: its verdict and exact counts (``sequences`` = 30^horizon)."""
+    """One start point at one arrival phase: its verdict and exact counts (``sequences`` = 30^horizon) at that
+    phase; ``window``: the arrival moments within this many seconds of it are covered too (0: the phase alone),
+    by a model whose robot capsules were grown by up to ``margin`` m (``verifier.arrival``); ``confirmed``:
+    sequences of that model hazardous at a moment of the window when replayed; ``alarms``: its other
+    hazardous sequences, hazardous at none of the moments replayed (not a proof, not a hazard)."""
 
     start: Name
     phase: float
+    window: Annotated[float, Field(ge=0.0)] = 0.0
+    margin: Annotated[float, Field(ge=0.0)] = 0.0
+    confirmed: Count = 0
+    alarms: Count = 0
     verdict: Literal[VERDICTS]
     sequences: Count
     hazardous: Count
@@ -62,6 +73,31 @@ class Subtree(Record):
     expanded: Count  # children made by the compiled expansion
     pruned: tuple[Pruned, ...]
     classes: tuple[ClassCount, ...]
+
+
+class Approximation(Record):
+    """One way the model the verdict is about differs from a continuous one, with its size."""
+
+    name: Name
+    size: float
+    unit: Name
+    what: Annotated[str, Field(max_length=400)]
+
+
+class Scope(Record):
+    """What a verdict covers (``verifier.scope``): the worker model and its actions, the horizon against the
+    cell's own, the start points, the arrival moments, and each approximation with its size; ``statement``
+    says it in one paragraph."""
+
+    worker: Name
+    actions: Count  # actions the worker chooses from at each decision
+    horizon: Count
+    cell_horizon: Count  # the cell's own simulation.actions_per_episode
+    starts: tuple[Name, ...]
+    arrival: Annotated[str, Field(max_length=400)]
+    margin: Annotated[float, Field(ge=0.0)]  # m: the largest capsule growth covering moments between grid points
+    approximations: tuple[Approximation, ...]
+    statement: Annotated[str, Field(max_length=4000)]
 
 
 class Witness(Record):
@@ -87,18 +123,18 @@ class VerifyResult(Record):
     options: VerifyOptions
     dt: float
     cycle: float
-    merge_xy: float  # m: positions closer than this were merged
-    merge_angle: float  # rad: headings and flexions closer than this were merged
+    scope: Scope
     verdict: Literal[VERDICTS]
     sequences: Count
     hazardous: Count
     undecided: Count
+    alarms: Count  # sequences hazardous only in the arrival-window model, at no moment replayed
     states: Count  # distinct states visited over every sub-tree
     pruned: tuple[Pruned, ...]
     subtrees: tuple[Subtree, ...]
     classes: tuple[Witness, ...]
     version: Name
-    format: Literal[1] = FORMAT
+    format: Literal[2] = FORMAT
 
     @property
     def exit_code(self) -> int:

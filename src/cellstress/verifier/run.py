@@ -5,6 +5,7 @@ does not depend on the number of workers or on which finished first."""
 from __future__ import annotations
 
 import multiprocessing
+import re
 import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
@@ -15,7 +16,9 @@ from typing import Any
 from pydantic import ValidationError
 
 from cellstress.cell.load import Cell
+from cellstress.core.cpus import check_workers
 from cellstress.core.errors import CellstressError
+from cellstress.core.io import OutputPathError
 from cellstress.core.version import __version__
 from cellstress.human.actions import N_ACTIONS
 from cellstress.searchers.distinct import hazard_class, hazard_class_record, root_cause
@@ -23,8 +26,9 @@ from cellstress.searchers.result import CellRef
 from cellstress.searchers.severity import worst_first
 from cellstress.sim.layout import M_STEP, M_T
 from cellstress.sim.simulator import Simulator
+from cellstress.verifier.arrival import ArrivalCover, arrival_cover, confirm_phases, inflated
 from cellstress.verifier.bounds import Bounds
-from cellstress.verifier.phases import StartPoint, arrival_phases, start_points
+from cellstress.verifier.phases import StartPoint, arrival_phases, phases_are_grid, start_points
 from cellstress.verifier.records import (
     PROVED_SAFE,
     UNDECIDED,
@@ -36,7 +40,8 @@ from cellstress.verifier.records import (
     VerifyResult,
     Witness,
 )
-from cellstress.verifier.tree import QUANT_ANGLE, QUANT_XY, decide
+from cellstress.verifier.scope import build_scope
+from cellstress.verifier.tree import TreeOutcome, decide
 from cellstress.verifier.witness import witness_actions, witness_severity, write_witness
 
 WITNESS_DIR = "witness-{:02d}"
@@ -48,24 +53,29 @@ class VerifyError(CellstressError):
 
 @dataclass(frozen=True)
 class Task:
-    """One sub-tree to decide: the cell, a start point, an arrival phase."""
+    """One sub-tree to decide: the cell, a start point, an arrival phase; ``cover``: how the moments within
+    its ``window`` (s; 0: the phase alone) are covered."""
 
     cell: Cell
     start: StartPoint
     phase: float
     options: VerifyOptions
     deadline: float | None  # time.time() after which it is left undecided
+    cover: ArrivalCover
+    window: float = 0.0
 
 
 @dataclass(frozen=True)
 class Found:
-    """A hazard class as one sub-tree found it: its first hit and the sequences of the class there."""
+    """A hazard class as one sub-tree found it: its first hit and the sequences of the class there; ``phase``:
+    the arrival moment it was played at (the sub-tree's, or one within its window)."""
 
     key: tuple
     actions: tuple[int, ...]
     step: int
     time_s: float
     sequences: int
+    phase: float
 
 
 @dataclass(frozen=True)
@@ -74,41 +84,95 @@ class Decided:
     found: tuple[Found, ...]
 
 
-# A per-process cache of the cell's simulator, keyed by the cell's hash and criterion: a worker builds the layout
-# (robot, reach field) once for all its sub-trees. A Simulator's results never depend on what it ran before.
-_SIMS: dict[tuple[str, str], Simulator] = {}
+# A per-process cache of the cell's simulators (the model, and the arrival-window model), keyed by the cell's hash
+# and criterion: a worker builds the layout (robot, reach field) once for all its sub-trees. A Simulator's
+# results never depend on what it ran before.
+_SIMS: dict[tuple[str, str, str], Simulator] = {}
 
 
-def _simulator(cell: Cell) -> Simulator:
-    key = (cell.sha256, cell.spec.criterion.type)
+def _simulator(cell: Cell, cover: ArrivalCover | None = None) -> Simulator:
+    key = (cell.sha256, cell.spec.criterion.type, "" if cover is None else "window")
     sim = _SIMS.get(key)
     if sim is None:
-        sim = _SIMS[key] = Simulator(cell)
+        sim = Simulator(cell) if cover is None else Simulator(inflated(_simulator(cell).layout, cover))
+        _SIMS[key] = sim
     return sim
 
 
-def decide_task(task: Task, progress: Callable[[int], None] | None = None) -> Decided:
-    """Decide one sub-tree (runs in a worker process)."""
-    opts = task.options
-    if task.deadline is not None and time.time() > task.deadline:  # not begun: all of it undecided
-        total = N_ACTIONS ** opts.horizon
-        return Decided(Subtree(start=task.start.name, phase=task.phase, verdict=UNDECIDED, sequences=total,
-                               hazardous=0, undecided=total, probability=0.0, states=(), expanded=0, pruned=(),
-                               classes=()), ())
-    sim = _simulator(task.cell).with_start(task.start.pose, task.phase)
-    deadline = None if task.deadline is None else time.monotonic() + (task.deadline - time.time())
-    out = decide(sim, opts.horizon, Bounds(sim, opts.bounds, opts.horizon), deadline=deadline, progress=progress)
+def _found(sim: Simulator, out: TreeOutcome, phase: float) -> dict[tuple, list]:
+    """The hazard classes of a tree's hits: key -> [key, first actions, step, time, sequences, phase]."""
     found: dict[tuple, list] = {}
     for hit in out.hits:
         key = hazard_class(sim, hit.state, hit.row)
         if key in found:
             found[key][4] += hit.sequences
         else:
-            found[key] = [key, hit.actions, int(hit.row[M_STEP]), round(float(hit.row[M_T]), 9), hit.sequences]
-    verdict = UNSAFE if out.hazardous else UNDECIDED if out.undecided else PROVED_SAFE
-    sub = Subtree(start=task.start.name, phase=task.phase, verdict=verdict, sequences=out.total,
-                  hazardous=out.hazardous, undecided=out.undecided, probability=out.hazardous / out.total,
-                  states=tuple(out.states), expanded=out.expanded,
+            found[key] = [key, hit.actions, int(hit.row[M_STEP]), round(float(hit.row[M_T]), 9), hit.sequences,
+                          phase]
+    return found
+
+
+def _confirm(task: Task, wide: TreeOutcome, found: dict[tuple, list]) -> tuple[int, int]:
+    """Replay each hazardous sequence of the arrival-window model at moments across the window, in the model
+    itself; one hazardous there is a hazard (its class found at that moment). Returns (confirmed, alarms)."""
+    base = _simulator(task.cell)
+    cycle = float(base.layout.trajectory.cycle)
+    sims = [(p, base.with_start(task.start.pose, p)) for p in confirm_phases(task.phase, task.cover, cycle)]
+    confirmed = alarms = 0
+    for hit in wide.hits:
+        for p, sim in sims:
+            trace = sim.run(list(hit.actions))
+            if trace.unsafe:
+                row = trace.rows[-1]
+                state = sim.reset()
+                for a in hit.actions:
+                    state, _ = sim.step(state, int(a))
+                key = hazard_class(sim, state, row)
+                if key not in found:
+                    found[key] = [key, hit.actions, int(row[M_STEP]), round(float(row[M_T]), 9), 0, p]
+                found[key][4] += hit.sequences
+                confirmed += hit.sequences
+                break
+        else:
+            alarms += hit.sequences
+    return confirmed, alarms
+
+
+def decide_task(task: Task, progress: Callable[[int], None] | None = None) -> Decided:
+    """Decide one sub-tree (runs in a worker process). With an arrival window, the window's model is decided
+    first: nothing hazardous there proves the whole window safe; otherwise the phase itself is decided
+    exactly, and the window model's hazardous sequences are replayed across the window (``verifier.arrival``)."""
+    opts = task.options
+    if task.deadline is not None and time.time() > task.deadline:  # not begun: all of it undecided
+        total = N_ACTIONS ** opts.horizon
+        return Decided(Subtree(start=task.start.name, phase=task.phase, window=task.window, verdict=UNDECIDED,
+                               sequences=total, hazardous=0, undecided=total, probability=0.0, states=(),
+                               expanded=0, pruned=(), classes=()), ())
+    deadline = None if task.deadline is None else time.monotonic() + (task.deadline - time.time())
+    sim = _simulator(task.cell).with_start(task.start.pose, task.phase)
+    confirmed = alarms = 0
+    margin = 0.0
+    if task.window > 0.0:
+        margin = task.cover.largest
+        wide_sim = _simulator(task.cell, task.cover).with_start(task.start.pose, task.phase)
+        wide = decide(wide_sim, opts.horizon, Bounds(wide_sim, opts.bounds, opts.horizon), deadline=deadline,
+                      progress=progress)
+        out = wide
+        found: dict[tuple, list] = {}
+        if wide.hazardous:  # the phase itself exactly, then the window's alarms replayed
+            out = decide(sim, opts.horizon, Bounds(sim, opts.bounds, opts.horizon), deadline=deadline)
+            found = _found(sim, out, task.phase)
+            if not out.hazardous and not out.timed_out:
+                confirmed, alarms = _confirm(task, wide, found)
+    else:
+        out = decide(sim, opts.horizon, Bounds(sim, opts.bounds, opts.horizon), deadline=deadline,
+                     progress=progress)
+        found = _found(sim, out, task.phase)
+    hazardous = out.hazardous
+    verdict = UNSAFE if hazardous or confirmed else UNDECIDED if out.undecided or alarms else PROVED_SAFE
+    sub = Subtree(start=task.start.name, phase=task.phase, window=task.window, margin=margin, confirmed=confirmed,
+                  alarms=alarms, verdict=verdict, sequences=out.total, hazardous=hazardous, undecided=out.undecided,
+                  probability=hazardous / out.total, states=tuple(out.states), expanded=out.expanded,
                   pruned=tuple(Pruned(bound=b, states=out.pruned_states[b], sequences=out.pruned_sequences[b])
                                for b in opts.bounds if b in out.pruned_states),
                   classes=())
@@ -124,9 +188,11 @@ def _init_worker() -> None:
     numba.set_num_threads(1)  # one thread per worker process: N workers on N cores
 
 
-def tasks_of(sim: Simulator, options: VerifyOptions, deadline: float | None) -> list[Task]:
+def tasks_of(sim: Simulator, options: VerifyOptions, deadline: float | None, cover: ArrivalCover) -> list[Task]:
     """The sub-trees of a verification, in the order of the result."""
-    return [Task(sim.cell, s, p, options, deadline) for s in start_points(sim.cell)
+    window = cover.half_window if cover.covered and options.moments == "all" and \
+        phases_are_grid(sim.cell, options.phases) else 0.0
+    return [Task(sim.cell, s, p, options, deadline, cover, window) for s in start_points(sim.cell)
             for p in arrival_phases(sim, s, options.phases)]
 
 
@@ -135,9 +201,10 @@ def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out:
     """Decide ``sim``'s cell (see ``cellstress.api.verify``). ``progress(sequences decided, of)``; ``out``: a folder
     for ``verify.json`` and one witness per hazard class (``witness-NN/result.json``)."""
     cell = sim.cell
-    _SIMS[(cell.sha256, cell.spec.criterion.type)] = sim
+    _SIMS[(cell.sha256, cell.spec.criterion.type, "")] = sim
     deadline = None if options.time_limit is None else time.time() + options.time_limit
-    tasks = tasks_of(sim, options, deadline)
+    cover = arrival_cover(sim, sim.contacts is not None)
+    tasks = tasks_of(sim, options, deadline, cover)
     total = len(tasks) * N_ACTIONS ** options.horizon
     done = [0]
 
@@ -146,7 +213,8 @@ def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out:
         if progress is not None:
             progress(done[0], total)
 
-    if workers <= 1 or len(tasks) == 1:
+    workers = min(workers, len(tasks))  # never a process without a sub-tree to decide
+    if workers <= 1:
         decided = [decide_task(t, tick) for t in tasks]
     else:
         # spawned, not forked: numba's thread pool in this process makes a fork unsafe
@@ -170,7 +238,7 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
             c = classes.get(f.key)
             if c is None:
                 c = classes[f.key] = {"task": task, "found": f, "sequences": 0}
-                c["actions"] = witness_actions(cell, task.start, task.phase, f.actions)
+                c["actions"] = witness_actions(cell, task.start, f.phase, f.actions)
                 c["severity"] = witness_severity(sim, c["actions"])
             c["sequences"] += f.sequences
     for i, c in enumerate(worst_first(list(classes.values()), key=lambda c: c["severity"])):
@@ -182,14 +250,20 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
         task, f, actions = c["task"], c["found"], c["actions"]
         rel = f"{WITNESS_DIR.format(c['index'] + 1)}/result.json"
         if out is not None:
-            write_witness(sim, actions, Path(out) / WITNESS_DIR.format(c["index"] + 1))
+            write_witness(sim, actions, Path(out), WITNESS_DIR.format(c["index"] + 1))
         klass = hazard_class_record(f.key)
         witnesses.append(Witness.model_construct(
-            klass=klass, root_cause=root_cause(klass), start=task.start.name, phase=task.phase,
+            klass=klass, root_cause=root_cause(klass), start=task.start.name, phase=f.phase,
             actions=actions, step=f.step, time_s=f.time_s, sequences=c["sequences"], file=rel,
             severity=c["severity"]))
     hazardous = sum(s.hazardous for s in subtrees)
     undecided = sum(s.undecided for s in subtrees)
+    alarms = sum(s.alarms for s in subtrees)
+    unsafe = any(s.verdict == UNSAFE for s in subtrees)
+    starts = tuple(dict.fromkeys(t.start.name for t in tasks))
+    grid = bool(tasks) and phases_are_grid(cell, options.phases)
+    scope = build_scope(sim, options, tasks[0].cover if tasks else arrival_cover(sim, sim.contacts is not None),
+                        grid, starts, tuple(sorted({t.phase for t in tasks})))
     pruned: dict[str, list[int]] = {}
     for s in subtrees:
         for p in s.pruned:
@@ -198,10 +272,11 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
             acc[1] += p.sequences
     source = cell.source if cell.directory is None else str(Path(cell.source).expanduser().resolve())
     result = VerifyResult(
-        cell=CellRef(name=cell.name, sha256=cell.sha256, source=source, criterion=cell.spec.criterion.type),
-        options=options, dt=sim.dt, cycle=float(sim.layout.trajectory.cycle), merge_xy=QUANT_XY,
-        merge_angle=QUANT_ANGLE, verdict=UNSAFE if hazardous else UNDECIDED if undecided else PROVED_SAFE,
-        sequences=sum(s.sequences for s in subtrees), hazardous=hazardous, undecided=undecided,
+        cell=CellRef(name=cell.name, sha256=cell.sha256, source=source, criterion=cell.spec.criterion.type,
+                     files=cell.files),
+        options=options, dt=sim.dt, cycle=float(sim.layout.trajectory.cycle), scope=scope,
+        verdict=UNSAFE if unsafe else UNDECIDED if undecided or alarms else PROVED_SAFE,
+        sequences=sum(s.sequences for s in subtrees), hazardous=hazardous, undecided=undecided, alarms=alarms,
         states=sum(sum(s.states) for s in subtrees),
         pruned=tuple(Pruned(bound=b, states=v[0], sequences=v[1]) for b, v in pruned.items()),
         subtrees=tuple(subtrees), classes=tuple(witnesses), version=__version__)
@@ -211,11 +286,24 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
 
 
 
-def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "all", time_limit: float | None = None,
-                bounds: tuple[str, ...] | None = None, workers: int = 1, out: str | Path | None = None,
-                progress: Callable[[int, int], None] | None = None) -> VerifyResult:
+def check_witness_folders(out: Path) -> None:
+    """Refuse, before any work, an output folder whose witness folders are links or files (planted there: a
+    witness is never written through one, ``core.io.write_in_folder``); OutputPathError naming it."""
+    if not out.is_dir():
+        return
+    for entry in sorted(out.iterdir()):
+        if re.fullmatch(r"witness-\d+", entry.name) and (entry.is_symlink() or not entry.is_dir()):
+            kind = "a symbolic link" if entry.is_symlink() else "not a folder"
+            raise OutputPathError(f"{entry}: is {kind}; cellstress never writes through a link or over a file "
+                                  f"inside its output folder {out} (remove it, or use another folder)")
+
+
+def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "all", moments: str = "all",
+                time_limit: float | None = None, bounds: tuple[str, ...] | None = None, workers: int = 1,
+                out: str | Path | None = None, progress: Callable[[int, int], None] | None = None) -> VerifyResult:
     """``run_verify`` with its options checked: VerifyError (a user error) for a bad one."""
-    fields: dict[str, Any] = {"horizon": sim.actions_per_episode if horizon is None else horizon, "phases": phases}
+    fields: dict[str, Any] = {"horizon": sim.actions_per_episode if horizon is None else horizon, "phases": phases,
+                              "moments": moments}
     if time_limit is not None:
         fields["time_limit"] = time_limit
     if bounds is not None:
@@ -225,8 +313,12 @@ def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "al
     except ValidationError as exc:
         e = exc.errors(include_url=False)[0]
         raise VerifyError(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}") from None
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise VerifyError(f"workers must be a whole number >= 1, not {workers!r}")
+    try:
+        check_workers(workers, "workers")
+    except CellstressError as exc:
+        raise VerifyError(str(exc)) from None
+    if out is not None:
+        check_witness_folders(Path(out))
     if sim.layout.worker.articulated:
         # its bounds are the paper worker's (30 actions, reach volumes on rigid shoulders: docs/verify.md)
         raise VerifyError(f"verify proves cells with the paper's worker only; this cell's is "

@@ -7,17 +7,18 @@ lexicographically smallest (its witness prefix): the states of a layer are kept 
 of state i by action a, numbered i * 30 + a, come in the order of their prefixes too, and the first child
 that falls on a merged state is the one whose prefix is the smallest.
 
-**Merging.** Two states merge when their future is the same: the same time step and actions played (true of a
-whole layer), positions equal to within ``QUANT_XY`` (1 um), heading (modulo a full turn), forward and lateral
-flexion equal to within ``QUANT_ANGLE`` (1e-9 rad), the latched stop time ``TSTOP`` bit for bit and the same
-triggering device, the guard doors' push and opening times and, in a cell of several robots, each
-other robot's latched stop ``XTSTOP``, bit for bit. The rest of the state does not reach the future:
-the first detection time ``TRIG_T`` is
-written by ``sense_and_measure`` and read by nothing; ``TRIG_DEV`` is only compared with -1 to decide whether
-to write ``TRIG_T``; neither enters the worker's motion, the robot (``robot_at`` reads the step and ``TSTOP``)
-or the unsafe test. ``TRIG_DEV`` is kept in the key all the same, because it names the device of a hazard's
-class (``searchers.distinct``): merging it away could hide a class. The merged state is the witness prefix's own
-state, bit for bit, so every witness is a sequence the simulator really plays.
+**Merging.** Two states merge when their futures are the same. What that takes is declared slot by slot in the
+state layout itself (``layout.STATE``: each slot's ``core.vector_spec.Merge``), and the key is derived from
+those declarations (``KEY_COLUMNS``), so a slot added later cannot be left out: every slot that anything
+reads is compared bit for bit (the worker's pose, the latched stops, releases, anchors, speed reductions,
+doors, speed commands in flight, other robots' stops), a slot that only an automatic release reads is ignored
+while no release can happen, and the slots nothing reads but the reports are left out. The simulator is
+deterministic, so merged states have identical futures: the merging approximates nothing. (An earlier key
+rounded positions to 1 um; a micrometre can decide whether a stride clears a fence's edge, so it could let
+one future stand for another.) ``TRIG_DEV`` is kept because it names the device of a hazard's class
+(``searchers.distinct``): merging it away could hide a class. ``tests/verifier/test_verify_merge.py`` sets
+the free slots to anything and plays on. The merged state is the witness prefix's own state, bit for bit, so
+every witness is a sequence the simulator really plays.
 
 **Counting.** A child that is unsafe ends its episode: all 30^r completions of its prefix are hazardous
 (r actions left), times its parent's multiplicity. A child proved safe by a bound (``verifier.bounds``) counts its
@@ -27,7 +28,6 @@ exactly when the tree is decided, and what a time limit leaves is reported as un
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -39,10 +39,7 @@ from cellstress.sim import layout as L
 from cellstress.sim.kernels.expand import expand_states
 from cellstress.verifier.bounds import Bounds
 
-QUANT_XY = 1e-6  # m: positions this close merge
-QUANT_ANGLE = 1e-9  # rad: headings and flexions this close merge
 CHUNK = 8192  # parents per compiled expansion (bounds memory; the time limit and progress are checked between)
-TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
@@ -81,22 +78,31 @@ class TreeOutcome:
         return self.undecided == 0
 
 
+def _key_columns() -> tuple[tuple[tuple[int, int, float], ...], int]:
+    """The merge key's columns, derived from the state layout's declarations (``layout.STATE.merges``): (slot,
+    slot it is free while or -1, value there) for every slot not declared free."""
+    cols = []
+    for i, g in enumerate(L.STATE.merges):
+        if g.kind == "free":
+            continue
+        cond = -1 if g.free_while is None else L.STATE.index(g.free_while)
+        cols.append((i, cond, np.nan if g.free_value is None else g.free_value))
+    return tuple(cols), len(cols)
+
+
+KEY_COLUMNS, N_KEY = _key_columns()
+KEY_SLOTS = np.array([c[0] for c in KEY_COLUMNS], dtype=np.int64)
+_CONDITIONAL = tuple((j, cond, value) for j, (_, cond, value) in enumerate(KEY_COLUMNS) if cond >= 0)
+
+
 def merge_keys(states: np.ndarray) -> np.ndarray:
-    """One fixed-size byte key per state (rows of ``states``): equal keys, equal futures (see the module)."""
-    nd, nx = 2 * L.MAX_DOORS, L.MAX_ROBOTS - 1
-    key = np.empty((len(states), 6 + nd + nx), dtype=np.int64)
-    key[:, 0] = np.rint(states[:, L.S_X] / QUANT_XY)
-    key[:, 1] = np.rint(states[:, L.S_Y] / QUANT_XY)
-    key[:, 2] = np.rint(np.mod(states[:, L.S_HEADING], TWO_PI) / QUANT_ANGLE)
-    key[:, 3] = np.rint(states[:, L.S_FWD] / QUANT_ANGLE)
-    key[:, 4] = np.rint(states[:, L.S_LAT] / QUANT_ANGLE)
-    key[:, 5] = states[:, L.S_TSTOP].view(np.int64) * 8 + (states[:, L.S_TRIG_DEV].astype(np.int64) + 1)
-    # the guard doors' push and opening times, bit for bit: they decide where the worker can go (inf in a cell
-    # without doors, so its keys only gain equal bytes at the end and keep their order)
-    key[:, 6:6 + nd] = np.ascontiguousarray(states[:, L.S_DOOR_REQ:L.S_DOOR_REQ + nd]).view(np.int64)
-    # robots 1..3's latched stops (inf in every state of a one-robot cell: the same partition and order as without)
-    key[:, 6 + nd:] = np.ascontiguousarray(states[:, L.S_XTSTOP:L.S_XTSTOP + nx]).view(np.int64)
-    return np.ascontiguousarray(key).view(np.dtype((np.void, key.dtype.itemsize * key.shape[1]))).ravel()
+    """One fixed-size byte key per state (rows of ``states``): equal keys, equal futures (see the module and
+    ``layout.STATE``). Every slot that is read is compared bit for bit."""
+    states = np.asarray(states, dtype=float).reshape(-1, L.NS)
+    key = np.ascontiguousarray(states[:, KEY_SLOTS]).view(np.int64)
+    for j, cond, value in _CONDITIONAL:
+        key[states[:, cond] == value, j] = 0  # free there: every value merges
+    return np.ascontiguousarray(key).view(np.dtype((np.void, key.dtype.itemsize * N_KEY))).ravel()
 
 
 class _Judge:

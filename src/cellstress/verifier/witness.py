@@ -46,7 +46,8 @@ def witness_result(sim, actions: list[str], source: str) -> SearchResult:
             break
     acts = tuple(actions)
     return SearchResult.model_construct(
-        cell=CellRef.model_construct(name=c.name, sha256=c.sha256, source=source, criterion=c.spec.criterion.type),
+        cell=CellRef.model_construct(name=c.name, sha256=c.sha256, source=source, criterion=c.spec.criterion.type,
+                                     files=c.files),
         searcher=SEARCHER, params={}, seed=0, budget=1, until="first", found=True, episodes=1,
         hazard=hazard_record(sim, 1, list(acts)),
         hazards=(EpisodeRef.model_construct(episode=1, actions=acts),),
@@ -62,8 +63,9 @@ def witness_severity(sim, actions: tuple[str, ...]) -> Severity:
     return severity(float(row[M_V]), None if verdict is None else verdict.as_dict())
 
 
-def write_witness(sim, actions: tuple[str, ...], folder: Path) -> Path:
-    """Write ``folder/result.json`` for a witness of ``sim``'s cell; returns its path."""
+def write_witness(sim, actions: tuple[str, ...], out: Path, folder: str) -> Path:
+    """Write ``out/folder/result.json`` for a witness of ``sim``'s cell; returns its path. ``folder`` is made
+    inside the output folder ``out`` without following a link planted there (``core.io.write_in_folder``)."""
     c = sim.cell
     source = c.source if c.directory is None else str(Path(c.source).expanduser().resolve())
-    return witness_result(sim, list(actions), source).write(folder)
+    return witness_result(sim, list(actions), source).write(Path(out) / folder, inside=out)

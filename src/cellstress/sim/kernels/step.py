@@ -37,6 +37,7 @@ from cellstress.sim.layout import (
     B_MODEL,
     B_N_CAPS,
     B_WALK_SPEED,
+    C_ANY_MOTION,
     C_DT,
     C_DTOL,
     C_PHASE0,
@@ -67,6 +68,7 @@ from cellstress.sim.layout import (
     MAX_ROBOTS,
     NO_WALK_BELOW,
     NS,
+    PHASE_STOPPED,
     POSE_EXT,
     S_A_SIG,
     S_A_T,
@@ -151,7 +153,11 @@ def sense_and_measure(P, state, W, row, action):
     owner = -1 if link < 0 else P.cap_robot[link]
     if owner > 0:
         v = W.xv[owner - 1]
-    unsafe = d_hr <= P.scal[C_DTOL] and v > P.scal[C_VTOL]
+    if P.scal[C_ANY_MOTION] != 0.0:  # (verify's arrival-window model: any robot that is not standing)
+        moving = (phase if owner <= 0 else W.xphase[owner - 1]) != PHASE_STOPPED
+    else:
+        moving = v > P.scal[C_VTOL]
+    unsafe = d_hr <= P.scal[C_DTOL] and moving
     row[M_ROBOT] = owner
     for r in range(MAX_ROBOTS - 1):
         row[M_XTAU + r] = W.xtau[r] if r < nx else -1.0  # (not NaN: rows are compared with array_equal)

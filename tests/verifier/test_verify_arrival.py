@@ -1,0 +1,109 @@
+"""Every arrival moment (verifier.arrival): the capsule margins hold every capsule position of the half step
+around a grid phase, and the arrival-window model is unsafe wherever the model is at an arrival moment between
+grid points; cells whose devices read the robot's clock are covered at the grid only, and say so."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cellstress
+from cellstress.sim import layout as L
+from cellstress.sim.scene import robot_capsules
+from cellstress.sim.simulator import Simulator
+from cellstress.verifier.arrival import arrival_cover, capsule_margins, clock_dependence, inflated
+from cellstress.verifier.phases import start_points
+from cellstress.verifier.records import PROVED_SAFE, UNSAFE
+
+CELLS = Path(__file__).parent / "cells"
+
+
+def _cell(name: str) -> str:
+    path = CELLS / f"{name}.yaml"
+    return str(path) if path.exists() else name
+
+
+@pytest.mark.parametrize("cell", ["baseline", "two-robots", "linear-axis"])
+def test_margins_hold_every_capsule_position_of_the_window(cell) -> None:
+    sim = Simulator(_cell(cell))
+    lay = sim.layout
+    half = 0.5 * sim.dt
+    margins = capsule_margins(lay, half) - float(lay.params.scal[L.C_REACH_H])
+    rng = np.random.default_rng(5)
+    tau0 = float(lay.params.scal[L.C_PHASE0])
+    worst = np.zeros(len(lay.capsules))
+    for tau in rng.uniform(0.0, float(lay.trajectory.cycle), 300):
+        a0, b0 = robot_capsules(lay, tau0 + tau)
+        for delta in rng.uniform(-half, half, 4):  # off the sampling grid, both directions
+            a1, b1 = robot_capsules(lay, tau0 + tau + delta)
+            moved = np.maximum(np.linalg.norm(a1 - a0, axis=1), np.linalg.norm(b1 - b0, axis=1))
+            worst = np.maximum(worst, moved)
+    assert np.all(worst <= margins + 1e-12)
+    moving = worst > 0.01
+    assert moving.any() and np.all(margins[moving] < 3.0 * worst[moving] + 0.01)  # and not uselessly loose
+
+
+# (cell, whether random actions find its hazards: the property is checked on every cell, and is not vacuous)
+WINDOW_CELLS = [("s1-scanner-width", True), ("s3-fence-gap", True), ("restart-auto", False),
+                ("warning-field-short", False), ("door-unlocked", False), ("two-robots", False), ("two-near", True),
+                ("restart-fast", True), ("warning-trunk", True), ("linear-axis", True)]
+
+
+@pytest.mark.parametrize(("cell", "random_finds"), WINDOW_CELLS)
+def test_the_window_model_is_unsafe_wherever_an_arrival_between_grid_points_is(cell, random_finds) -> None:
+    base = Simulator(_cell(cell))
+    cover = arrival_cover(base, base.contacts is not None)
+    assert cover.covered, cover.reason
+    wide = Simulator(inflated(base.layout, cover))
+    start = start_points(base.cell)[0].pose
+    rng = np.random.default_rng(3)
+    dt = base.dt
+    cycle = float(base.layout.trajectory.cycle)
+    hazards = 0
+    for _ in range(12):
+        grid = float(rng.integers(0, int(cycle / dt))) * dt
+        real_sims = [base.with_start(start, grid + d) for d in rng.uniform(-0.5 * dt, 0.5 * dt, 3)]
+        wide_sim = wide.with_start(start, grid)
+        acts = rng.integers(0, 30, size=(300, base.actions_per_episode))
+        flagged = wide_sim.run_batch(acts).unsafe_step
+        for sim in real_sims:
+            real = sim.run_batch(acts).unsafe_step
+            hit = real >= 0
+            hazards += int(hit.sum())
+            # unsafe in the window model too, and no later than the real step (it is unsafe wherever the real is)
+            assert np.all(flagged[hit] >= 0) and np.all(flagged[hit] <= real[hit]), cell
+    assert hazards > 0 or not random_finds
+
+
+def test_clock_reading_cells_are_covered_at_the_grid_only() -> None:
+    for cell, words in (("ssm-latency", "separation"), ("muting-long", "muted")):
+        sim = Simulator(cell)
+        assert words in (clock_dependence(sim.layout) or ""), cell
+        assert not arrival_cover(sim, False).covered
+    # muting-long's pallet is a timed panel: without the muting it still reads the clock
+    lay = Simulator("muting-long").layout
+    assert lay.params.panel_fence.shape[0] > 0
+    unmuted = dataclasses.replace(lay, params=lay.params._replace(dev_muted=np.full_like(lay.params.dev_muted, np.inf)))
+    assert "timed panel" in (clock_dependence(unmuted) or "")
+    assert clock_dependence(Simulator("baseline").layout) is None
+    assert "criterion" in arrival_cover(Simulator("baseline"), True).reason
+
+
+def test_a_hazard_only_between_grid_moments_is_not_proved_safe(tmp_path) -> None:
+    # pass-by: the arm touches the worker only at arrival moments strictly between the 50 ms grid moments
+    cell = str(CELLS / "pass-by.yaml")
+    grid = cellstress.verify(cell, moments="grid")
+    assert grid.verdict == PROVED_SAFE and grid.hazardous == 0  # what the grid alone says
+    assert "only" in grid.scope.arrival
+    res = cellstress.verify(cell, out=tmp_path)
+    assert res.verdict != PROVED_SAFE
+    assert res.hazardous == 0  # none at the grid moments themselves
+    assert res.verdict == UNSAFE and res.classes  # the replay across the windows found them
+    for w in res.classes:
+        assert abs(w.phase / 0.05 - round(w.phase / 0.05)) > 1e-6  # at a moment between grid points
+        replayed = Simulator(cell).run(list(w.actions))
+        assert replayed.unsafe
+    assert "every arrival moment" in res.scope.arrival and res.scope.margin > 0.0
