@@ -306,7 +306,8 @@ def test_cli_runner_user_error_is_one_line() -> None:
         "(baseline, s1-scanner-width, s2-elbow-intrusion, s3-fence-gap, all-flaws, s2-deceptive, restart-auto, "
         "restart-manual, warning-field-short, warning-field-ok, mat-short, mat-ok, palletizing, palletizing-fixed, "
         "door-unlocked, door-locked, muting-long, muting-ok, "
-        "two-robots, two-robots-fixed, ssm-latency, ssm-ok, reach-over, reach-over-ok, long-gripper, long-gripper-ok)"
+        "two-robots, two-robots-fixed, ssm-latency, ssm-ok, reach-over, reach-over-ok, long-gripper, long-gripper-ok, "
+        "machine-tending)"
     )
     assert result.stdout == ""
 

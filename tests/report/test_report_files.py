@@ -13,11 +13,13 @@ from cellstress.report import draw as D
 from cellstress.report.animate import AnimationOptions
 from cellstress.report.hazard import StillOptions
 from cellstress.report.make import NAMES
+from cellstress.report.program import ProgramPicture
 
 MIN_STD = 8.0  # grey-level standard deviation: a blank or single-colour image is far below this
 
 SIZES = {"topview.png": StillOptions().topview.pixels, "contact.png": StillOptions().contact.pixels,
-         "risk.png": StillOptions().risk.pixels, "replay.gif": AnimationOptions().size.pixels}
+         "risk.png": StillOptions().risk.pixels, "replay.gif": AnimationOptions().size.pixels,
+         "program.png": ProgramPicture().size.pixels}
 
 
 def _not_blank(img: Image.Image) -> float:
@@ -33,7 +35,7 @@ def test_images_decode_with_size_and_content(s3_report, name):
 
 
 def test_pngs_carry_no_version_or_date(s3_report):
-    for name in ("topview.png", "contact.png", "risk.png"):
+    for name in ("topview.png", "contact.png", "risk.png", "program.png"):
         with Image.open(s3_report / name) as img:
             assert not any("matplotlib" in str(v).lower() for v in img.info.values()), img.info
 

@@ -40,8 +40,8 @@ def test_html_is_self_contained(s3_report):
     assert tags[0] == "html" and "body" in tags and "table" in tags
     assert "script" not in tags and "link" not in tags and "iframe" not in tags
     imgs = [a for t, a in page.tags if t == "img"]
-    assert len(imgs) == 4
-    assert sorted(a["src"].split(";")[0] for a in imgs) == ["data:image/gif"] + ["data:image/png"] * 3
+    assert len(imgs) == 5  # top view, contact, animation, risk, the robot's program
+    assert sorted(a["src"].split(";")[0] for a in imgs) == ["data:image/gif"] + ["data:image/png"] * 4
     for _, attrs in page.tags:
         for key in ("src", "href", "action", "poster", "data"):
             value = attrs.get(key)

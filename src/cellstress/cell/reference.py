@@ -52,6 +52,7 @@ robot:
     dwells: [0.5, 0.2]
     # (b) or tool poses in the cell's frame, solved by inverse kinematics when the cell is loaded
     # tool_frame: panda_hand
+    # ik_seed_deg: [0, -45, 0, -135, 0, 90, 45]   # the home the first pose is solved nearest (docs/programs.md)
     # poses:
     #   - {xyz: [-0.55, 0.45, 1.05], rpy_deg: [180, 0, 0]}
     #   - {xyz: [0.55, 0.45, 1.05], rpy_deg: [180, 0, 0]}

@@ -21,6 +21,12 @@ from cellstress.robot.stopping_file import StoppingFileError, read_stopping_file
 from cellstress.robot.trajectory import Trajectory
 
 
+def stopping_data_path(ref: str, directory: Path | None) -> Path:
+    """The stopping data file a cell names, relative to the cell file's folder."""
+    path = Path(ref).expanduser()
+    return directory / path if not path.is_absolute() and directory is not None else path
+
+
 def robot_stop(src: str, where: str, rs: RobotSpec, robot: RobotModel, traj: Trajectory,
                directory: Path | None) -> RobotStop:
     """How robot ``rs`` stops; errors name ``where`` (robot or robots[i]) as the field's start."""
@@ -29,9 +35,7 @@ def robot_stop(src: str, where: str, rs: RobotSpec, robot: RobotModel, traj: Tra
     if st.data is None:
         return given_stop(st.category, float(st.controller_delay), float(st.time), robot, peaks)
     field = f"{where}.stopping.data"
-    path = Path(st.data).expanduser()
-    if not path.is_absolute() and directory is not None:
-        path = directory / path
+    path = stopping_data_path(st.data, directory)
     try:
         rows = read_stopping_file(path)
         joints = joint_stops(rows, st.category, robot, peaks, float(st.payload_kg), float(st.extension_pct))

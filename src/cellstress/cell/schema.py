@@ -117,13 +117,16 @@ class TaskSpec(Record):
     for prismatic ones; within the joints' limits."""
     poses: tuple[ToolPose, ...] = Field((), max_length=MAX_WAYPOINTS)
     """Tool poses to visit (at least 2), instead of ``waypoints_deg``: each is solved by inverse kinematics
-    within the joint limits, starting from the previous waypoint's solution (the first from ``ik_seed_deg``),
-    so the arm keeps its configuration; a pose it cannot reach within 1 mm and 1 deg is an error."""
+    within the joint limits, the solution whose move from the previous waypoint takes least time (the first
+    pose's from ``ik_seed_deg``), each joint by the whole turn nearest the previous value, and no joint turning
+    further over the cycle than needed (docs/programs.md); a pose it cannot reach within 1 mm and 1 deg is an
+    error."""
     tool_frame: Name | None = None
     """The URDF link or frame that ``poses`` place (e.g. panda_hand, tool0); required with ``poses``."""
     ik_seed_deg: Annotated[tuple[JointAngle, ...], Field(max_length=MAX_JOINTS)] | None = None
-    """Where the search for the first pose starts: a value per driven joint, as in ``waypoints_deg``;
-    absent: the middle of each joint's range."""
+    """The program's start configuration (the robot's home), a value per driven joint as in
+    ``waypoints_deg``: the first pose's solution is the one nearest it. Absent: the middle of each joint's range
+    (for a UR, the arm stretched out level: give the home you would jog from)."""
     trajectory_csv: Annotated[str, Field(min_length=1, max_length=1000, pattern=r"^[^\x00]+$")] | None = None
     """A joint-trajectory file (as controllers and offline-programming tools export), instead of waypoints:
     CSV with a header ``time`` then one column per driven joint (``q1, q2, ...`` or the joint names, in URDF

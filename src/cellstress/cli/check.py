@@ -17,6 +17,7 @@ def check(
     Exit code 0 if the static check passes, 1 if it fails (a gate for a design in CI), 2 for a file that is not
     a valid cell."""
     from cellstress.analysis.iso13855 import check_cell
+    from cellstress.analysis.program_check import check_programs
     from cellstress.analysis.robot_audit import audit_robot
     from cellstress.cell.load import BUILTIN_CELLS, builtin_file, load_cell
     from cellstress.robot.geometry import robot_geometry
@@ -28,6 +29,7 @@ def check(
         layout = build_layout(c)
         static = check_cell(c, layout)
         audits = [audit_robot(robot_geometry(p.model.urdf), p.capsules, p.joints) for p in layout.robots]
+        programs = check_programs(layout)
 
     out = say
     where = f"built-in: {builtin_file(cell)}" if cell in BUILTIN_CELLS else f"file: {c.source}"
@@ -59,13 +61,17 @@ def check(
     sim = spec.simulation
     out(f"simulation  dt {num(sim.dt)} s, {sim.steps_per_action} steps per action, "
         f"{sim.actions_per_episode} actions per episode")
+    out("robot program check:")
+    for line in (line for p in programs for line in p.lines()):
+        out(f"  {line}")
     out("ISO 13855 static check:")
     for line in static.lines():
         out(f"  {line}")
-    if static.ok:
+    failures = [f for p in programs for f in p.failures()] + static.failures()
+    if not failures:
         out("PASS: the cell file is valid and the static check passes")
     else:
-        out(f"FAIL: the cell file is valid, the static check fails ({', '.join(static.failures())})")
+        out(f"FAIL: the cell file is valid, the static check fails ({', '.join(failures)})")
         raise typer.Exit(1)
 
 

@@ -63,7 +63,8 @@ def robot_block(short_name: str) -> str:
     # one value per joint the program drives, in degrees (metres for a prismatic joint):
 {names}
     # A starting point within the joint limits: replace it by the cell's own program (or give tool poses:
-    # poses + tool_frame; or a joint-trajectory file: trajectory_csv; see docs/cell-format.md)
+    # poses + tool_frame, and the robot's home as ik_seed_deg; or a joint-trajectory file: trajectory_csv; see
+    # docs/cell-format.md and docs/programs.md). `cellstress check` prints each move; `show --program` draws it.
     waypoints_deg:
       - {row(mid)}
       - {row(turned)}

@@ -45,24 +45,29 @@ def show(
                                         "cell file.")],
     out: Annotated[str | None, typer.Option("--out", "-o", help="PNG file to write (default: the cell's name "
                                             "as a plain file name, .png, in the current folder).")] = None,
+    program: Annotated[bool, typer.Option("--program", help="Draw the robot's program alone instead: its moves "
+                                          "over one cycle from above and the side, with the program check.")] = False,
 ) -> None:
-    """Draw a cell's layout to scale (fences, table, devices, the robot's swept area, the start) as a PNG."""
+    """Draw a cell's layout to scale (fences, table, devices, the robot's swept area, the start) as a PNG; with
+    --program, the robot's program over one cycle (no worker)."""
     from cellstress.cell.load import load_cell
 
     try:
         c = load_cell(cell)
     except CellstressError as exc:
         raise fail(str(exc)) from None
-    path = Path(out) if out is not None else Path(f"{slug(c.spec.name)}.png")
+    default = f"{slug(c.spec.name)}-program.png" if program else f"{slug(c.spec.name)}.png"
+    path = Path(out) if out is not None else Path(default)
     if path.suffix.lower() != ".png":
         raise fail(f"--out {out}: the picture is a PNG file, give a name ending in .png")
     from cellstress.report.make import show_cell
+    from cellstress.report.program import show_program
 
     try:
         if path.parent != Path(""):
             path.parent.mkdir(parents=True, exist_ok=True)
         with spinner_while_compiling():
-            show_cell(c, path)
+            (show_program if program else show_cell)(c, path)
     except CellstressError as exc:
         raise fail(str(exc)) from None
     except OSError as exc:

@@ -1,5 +1,5 @@
-"""A search result's report: topview.png, contact.png, replay.gif, risk.png and report.html, written next to
-result.json. The same result.json gives the same files (no dates, no versions in the PNGs).
+"""A search result's report: topview.png, contact.png, replay.gif, risk.png, program.png and report.html,
+written next to result.json. The same result.json gives the same files (no dates, no versions in the PNGs).
 """
 
 from __future__ import annotations
@@ -16,12 +16,13 @@ from cellstress.report import html as H
 from cellstress.report.animate import AnimationOptions, animate
 from cellstress.report.episode import EpisodeView, episode_of
 from cellstress.report.hazard import StillOptions, contact_figure, risk_figure, topview_figure
+from cellstress.report.program import program_figure
 from cellstress.report.scope import NOT_A_PROOF, judged_by, search_scope, strongest_contact
 from cellstress.report.story import Account, account
 from cellstress.searchers.result import FILE_NAME, SearchResult
 from cellstress.searchers.severity import words as severity_words
 
-NAMES = ("topview.png", "contact.png", "replay.gif", "risk.png", "report.html")
+NAMES = ("topview.png", "contact.png", "replay.gif", "risk.png", "program.png", "report.html")
 
 
 class ReportError(CellstressError):
@@ -40,6 +41,7 @@ class ReportFiles:
     contact: Path
     replay: Path
     risk: Path
+    program: Path
     html: Path
     account: Account
     found: bool
@@ -47,7 +49,7 @@ class ReportFiles:
 
     @property
     def paths(self) -> tuple[Path, ...]:
-        return (self.topview, self.contact, self.replay, self.risk, self.html)
+        return (self.topview, self.contact, self.replay, self.risk, self.program, self.html)
 
 
 def _load(result: SearchResult | str | Path) -> tuple[SearchResult, Path | None]:
@@ -93,15 +95,17 @@ def write_report(result: SearchResult | str | Path, out_dir: str | Path | None =
     title = f"{res.searcher}, seed {res.seed}: max risk per episode ({res.episodes} episodes)"
     risk = D.save_png(risk_figure(res.risk_per_episode, h.episode if h else None, st.risk, title,
                                   tuple(e.episode for e in res.hazards)), out / NAMES[3])
+    program = D.save_png(program_figure(sim.layout), out / NAMES[4])
     acc = account(view, res.episodes)
     changed = sim.cell.sha256 != res.cell.sha256 or (  # or a file it reads (a URDF, a mesh; issue 29)
         res.cell.files is not None and bool(file_changes(res.cell.files, sim.cell.files)))
     strongest = None if res.found else strongest_contact(sim, view.actions)
     why = None if not res.found or res.hazard.why is None else shortfall(res.hazard.why, check_cell(sim.cell))
     page = hazard_page(res, view, acc, top, contact, gif, risk, changed, Judgement(
-        judged_by(sim.criterion), search_scope(res, sim.cell.spec, sim.layout.trajectory.cycle), strongest, why))
-    html = H.write_page(out / NAMES[4], page)
-    return ReportFiles(top, contact, gif, risk, html, acc, res.found, changed)
+        judged_by(sim.criterion), search_scope(res, sim.cell.spec, sim.layout.trajectory.cycle), strongest, why),
+        program)
+    html = H.write_page(out / NAMES[5], page)
+    return ReportFiles(top, contact, gif, risk, program, html, acc, res.found, changed)
 
 
 def _fmt(x, nd: int = 3) -> str:
@@ -137,7 +141,7 @@ class Judgement:
 
 
 def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, contact: Path, gif: Path,
-                risk: Path, cell_changed: bool, judgement: Judgement) -> str:
+                risk: Path, cell_changed: bool, judgement: Judgement, program: Path | None = None) -> str:
     cell = res.cell.name
     e = H.escape
     body = [f"<h1>cellstress report: {e(cell)}</h1>"]
@@ -183,6 +187,10 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
                          "shown at a quarter of real time).", "animated replay"))
     body.append(H.figure(risk, "The search: each episode's maximum risk (the searcher's guide, not the verdict) "
                          "and the highest so far; hazardous episodes in red.", "risk plot"))
+    if program is not None:
+        body.append(H.figure(program, "The robot's program alone over one cycle, from above and from the side: each "
+                             "move in its colour, the poses at the waypoints outlined, the tool's path, and the "
+                             "program check (cellstress check) beneath.", "robot program"))
     body.append("<h2>Actions</h2>")
     rows, classes = action_rows(view)
     body.append(H.table(["#", "action", "t [s]", "position at end [m]", "heading [deg]", "forward [deg]",

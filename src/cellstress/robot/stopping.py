@@ -168,13 +168,13 @@ def joint_stops(rows: tuple[StoppingRow, ...], category: int, robot: RobotModel,
     none of its own: both are controlled stops along the path). StoppingDataError otherwise."""
     index = {n: j for j, n in enumerate(robot.joint_names)}
     for r in rows:
-        if r.joint not in index:
-            raise StoppingDataError(f"row {r.row}, column 1 (joint)", f"the robot has no joint {r.joint[:60]!r}; "
-                                                                      f"its joints are {', '.join(robot.joint_names)}")
+        if r.joint not in index:  # (the file's text is never quoted: a cell may name any file)
+            raise StoppingDataError(f"row {r.row}, column 1 (joint)", f"is not a joint of the robot; its joints are "
+                                                                      f"{', '.join(robot.joint_names)}")
         kind = robot.kinds[index[r.joint]]
         if (kind == REVOLUTE) != r.angular:
             want = "deg or rad" if kind == REVOLUTE else "m or mm"
-            raise StoppingDataError(f"row {r.row}, column 7 (unit)", f"joint {r.joint!r} is {kind}: its distance "
+            raise StoppingDataError(f"row {r.row}, column 7 (unit)", f"joint {r.joint} is {kind}: its distance "
                                                                      f"is in {want}")
     use = [r for r in rows if r.category == category]
     if not use and category == 2:

@@ -17,7 +17,8 @@ CSV, one published point per row, after a header naming the columns in this orde
 * ``time_s`` (or ``time_ms``, the header says which): the time from the stop signal to standstill.
 
 The file is untrusted: its size and row count are bounded before anything is parsed, and every bad value is one
-error naming its row (the header is row 1 after the comments: a row is its line) and its column.
+error naming its row (a row is its line, comments counted) and its column. An error never quotes the file's text:
+a cell may name any file (``/etc/passwd``), and its first line must not end up in a log.
 """
 
 from __future__ import annotations
@@ -74,9 +75,10 @@ def read_stopping_file(path: Path) -> tuple[StoppingRow, ...]:
     except UnicodeDecodeError as exc:
         line = raw[: exc.start].count(b"\n") + 1
         raise StoppingFileError(f"row {line}", "is not UTF-8 text") from None
-    if text.count("\n") > MAX_ROWS + 1:
+    text = text.replace("\r\n", "\n").replace("\r", "\n")  # a row ends at any of the three line ends
+    lines = text.split("\n")
+    if len(lines) - (not lines[-1]) > MAX_ROWS + 1:  # a header and MAX_ROWS rows (comments count as rows)
         raise StoppingFileError("", f"has more than {MAX_ROWS:,} rows")
-    lines = text.splitlines()
     first = next((i for i, ln in enumerate(lines) if ln.strip() and not ln.lstrip().startswith("#")), None)
     if first is None:
         raise StoppingFileError("", "has no header; it needs 'joint,category,speed_pct,payload_kg,extension_pct,"
@@ -87,8 +89,8 @@ def read_stopping_file(path: Path) -> tuple[StoppingRow, ...]:
         raise StoppingFileError(f"row {first + 1}", f"not valid CSV ({exc})") from None
     want = ",".join(COLUMNS)
     if tuple(header[:-1]) != COLUMNS or len(header) != len(COLUMNS) + 1 or header[-1] not in TIME_COLUMNS:
-        raise StoppingFileError(f"row {first + 1}", f"the header must be {want},time_s (or time_ms); got "
-                                                    f"{','.join(header)[:200]}")
+        raise StoppingFileError(f"row {first + 1}", f"the header must be {want},time_s (or time_ms); "
+                                                    f"{_header_problem(header)}")
     time_scale = TIME_COLUMNS[header[-1]]
     out: list[StoppingRow] = []
     seen: dict[tuple, int] = {}
@@ -110,6 +112,14 @@ def read_stopping_file(path: Path) -> tuple[StoppingRow, ...]:
     return tuple(out)
 
 
+def _header_problem(header: list[str]) -> str:
+    """What is wrong with the header, by column number: never the file's own words."""
+    if len(header) != len(COLUMNS) + 1:
+        return f"it has {len(header)} columns, not {len(COLUMNS) + 1}"
+    k = next((k for k, h in enumerate(header[:-1]) if h != COLUMNS[k]), len(COLUMNS))
+    return f"column {k + 1} should be {COLUMNS[k] if k < len(COLUMNS) else 'time_s or time_ms'}"
+
+
 def _row(row: list[str], r: int, header: list[str], time_scale: float) -> StoppingRow:
     if len(row) != len(header):
         raise StoppingFileError(f"row {r}", f"has {len(row)} values; expected {len(header)} ({','.join(header)})")
@@ -122,14 +132,14 @@ def _row(row: list[str], r: int, header: list[str], time_scale: float) -> Stoppi
         raise StoppingFileError(where(0), "needs a joint name (at most 200 characters)")
     cat = row[1].strip()
     if cat not in ("0", "1", "2"):
-        raise StoppingFileError(where(1), f"{cat[:30]!r} is not a stop category (0, 1 or 2)")
+        raise StoppingFileError(where(1), "is not a stop category (0, 1 or 2)")
     speed = _number(row[2], where(2), 0.0, 100.0, low_open=True)
     payload = _number(row[3], where(3), 0.0, MAX_PAYLOAD)
     extension = _number(row[4], where(4), 0.0, 100.0, low_open=True)
     unit = row[6].strip()
     if unit not in ANGLE_UNITS and unit not in LENGTH_UNITS:
-        raise StoppingFileError(where(6), f"{unit[:30]!r} is not a unit: deg or rad (revolute joints), m or mm "
-                                          "(prismatic joints)")
+        raise StoppingFileError(where(6), "is not a unit: deg or rad (revolute joints), m or mm (prismatic "
+                                          "joints)")
     scale = ANGLE_UNITS.get(unit, LENGTH_UNITS.get(unit, 1.0))
     top = 4.0 * math.pi if unit in ANGLE_UNITS else 10.0  # two turns; 10 m
     distance = _number(row[5], where(5), 0.0, top / scale) * scale
@@ -141,8 +151,8 @@ def _number(text: str, where: str, lo: float, hi: float, low_open: bool = False)
     try:
         x = float(text)
     except ValueError:
-        raise StoppingFileError(where, f"{text.strip()[:30]!r} is not a number") from None
+        raise StoppingFileError(where, "is not a number") from None
     if not math.isfinite(x) or x < lo or x > hi or (low_open and x == lo):
         side = f"above {lo:g}" if low_open else f"at least {lo:g}"
-        raise StoppingFileError(where, f"{text.strip()[:30]} is out of range ({side} and at most {hi:g})")
+        raise StoppingFileError(where, f"is out of range (a finite number {side} and at most {hi:g})")
     return x
