@@ -37,7 +37,8 @@ BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intr
                                   "warning-field-ok", "mat-short", "mat-ok", "palletizing", "palletizing-fixed",
                                   "door-unlocked", "door-locked", "muting-long", "muting-ok",
                                   "two-robots", "two-robots-fixed", "ssm-latency", "ssm-ok", "reach-over",
-                                  "reach-over-ok", "long-gripper", "long-gripper-ok", "machine-tending")
+                                  "reach-over-ok", "long-gripper", "long-gripper-ok", "machine-tending",
+                                  "machine-tending-delay", "machine-tending-delay-ok")
 
 
 @dataclass(frozen=True)
