@@ -17,7 +17,7 @@ from pydantic import BaseModel, ValidationError
 
 from cellstress.cell.files import cell_files, refuse_files_outside
 from cellstress.cell.program import robot_program
-from cellstress.cell.robot_stop import robot_stop
+from cellstress.cell.robot_stop import check_hold, robot_stop
 from cellstress.cell.schema import CRITERIA, DEVICE_KINDS, CellSpec
 from cellstress.core import registry
 from cellstress.core.errors import CellError, CellstressError
@@ -384,9 +384,8 @@ def _check_robot(cell: Cell, rs, where: str) -> float:
         if where == "robot" or not exc.field.startswith("robot."):
             raise
         raise CellError(src, where + exc.field.removeprefix("robot"), exc.problem) from None
-    robot_stop(src, where, rs, robot, traj, cell.files_dir)
-    if rs.stop.category == 0:
-        _check_hold(cell, where)
+    if robot_stop(src, where, rs, robot, traj, cell.files_dir).hold:
+        check_hold(cell, where)
     caps = rs.capsules if rs.capsules != "auto" else ()
     for i, c in enumerate(tuple(caps) + rs.extra_capsules):
         if c.link not in robot.link_joint:
@@ -456,19 +455,6 @@ def _check_robot_names(cell: Cell) -> None:
                             "a warning field" if c.speed != 0.0 else "an automatic restart")
                     raise CellError(src, f"devices[{i}]", f"has {what}; a cell with several robots takes devices "
                                                           "whose stops are manual only (not implemented yet)")
-
-
-def _check_hold(cell: Cell, where: str) -> None:
-    """A category 0 stop removes power: the robot cannot follow a warning field's slower speed, a separation
-    monitor's speed commands or an automatic restart back onto its path, which all assume a controlled stop."""
-    for i, d in enumerate(cell.spec.devices):
-        for c in _channels(d):
-            if c.separation is not None or c.speed != 0.0 or c.clear_time != float("inf"):
-                what = ("speed and separation monitoring" if c.separation is not None else
-                        "a warning field" if c.speed != 0.0 else "an automatic restart")
-                raise CellError(cell.source, f"{where}.stopping.category", f"is 0, but devices[{i}] has {what}, "
-                                                                           "which needs a controlled stop (category "
-                                                                           "1 or 2)")
 
 
 def _channels(d) -> tuple[Channel, ...]:

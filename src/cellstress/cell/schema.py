@@ -215,11 +215,10 @@ class RobotSpec(Record):
     extra_capsules: tuple[CapsuleSpec, ...] = Field((), max_length=MAX_CAPSULES)
     """Capsules added to the robot's own, e.g. a gripper holding a part."""
     stopping_time: PositiveTime = 0.15
-    """Time [s] from the stop signal to standstill, braking along the path (stop category 1 without a controller
-    delay; the paper's 0.15 s). ``stopping`` says more, instead."""
+    """Time [s] from the stop signal to standstill, braking along the path (category 1, no delay; the paper's)."""
     stopping: StoppingSpec | None = None
-    """How the robot stops, instead of ``stopping_time``: its stop category, its controller's delay and its
-    braking time or its maker's stopping data (docs/robot.md, Stopping)."""
+    """How the robot stops, instead of ``stopping_time``: stop category, controller delay, braking time or the
+    maker's stopping data (docs/robot.md, Stopping)."""
     pedestal: Literal["auto", "none"] = "auto"
     """auto: the robot's base (the shapes of the links that do not move, in plan, from the floor up to their top)
     is an obstacle the worker cannot walk or lean into; none: nothing below the base (a robot hung from above)."""
@@ -227,20 +226,6 @@ class RobotSpec(Record):
     """Joints the program does not drive, each held at a value (a gripper at a set opening)."""
     task: TaskSpec
     """The robot's cyclic program."""
-
-    @model_validator(mode="after")
-    def _one_stop(self) -> RobotSpec:
-        if self.stopping is not None and "stopping_time" in self.model_fields_set:
-            raise ValueError("give stopping_time or a stopping block, not both (stopping.time is the braking time)")
-        return self
-
-    @property
-    def stop(self) -> StoppingSpec:
-        """The ``stopping`` block; for a cell that gives ``stopping_time`` only, the block that says the same."""
-        if self.stopping is not None:
-            return self.stopping
-        return StoppingSpec.model_construct(category=1, controller_delay=0.0, time=self.stopping_time, data=None,
-                                            payload_kg=None, extension_pct=100.0)
 
     @field_validator("hold")
     @classmethod

@@ -47,3 +47,12 @@ class StoppingSpec(Record):
         if self.data is None and (self.payload_kg is not None or "extension_pct" in self.model_fields_set):
             raise ValueError("payload_kg and extension_pct are for reading stopping data; this block gives a time")
         return self
+
+
+def stop_spec(rs) -> StoppingSpec:
+    """A robot's (``cell.schema.RobotSpec``) ``stopping`` block; for one that gives ``stopping_time`` only, the block
+    that says the same (category 1, no delay, that braking time)."""
+    if rs.stopping is not None:
+        return rs.stopping
+    return StoppingSpec.model_construct(category=1, controller_delay=0.0, time=rs.stopping_time, data=None,
+                                        payload_kg=None, extension_pct=100.0)
