@@ -175,6 +175,16 @@ def _task(**task) -> Callable[[dict], None]:
     return change
 
 
+def _stopping(**block) -> Callable[[dict], None]:
+    """The robot's stopping block (issue 28) instead of its stopping_time."""
+    def change(cell: dict) -> None:
+        cell["robot"].pop("stopping_time", None)
+        cell["robot"]["stopping"] = block
+
+    return change
+
+
+_STOP_HEAD = b"joint,category,speed_pct,payload_kg,extension_pct,distance,unit,time_s\n"
 _CSV_HEAD = b"time,q1,q2,q3,q4,q5,q6\n0,1.4,-0.8,1.3,-2.1,-1.57,0\n"
 _ENTITY_BOMB = (b'<?xml version="1.0"?><!DOCTYPE r [<!ENTITY a "aaaaaaaaaa">'
                 + b"".join(f'<!ENTITY {chr(98 + i)} "{("&" + chr(97 + i) + ";") * 10}">'.encode() for i in range(8))
@@ -315,6 +325,23 @@ BAD_CELLS: list[tuple[str, dict, tuple[str, ...]]] = [
         "center": [0.7, 3.35], "size": [0.4, 0.4]}}])}, ("human.start", "crate")),
     ("arrival-backwards", {"cell": _set("human.arrival", {"start": 5.0, "end": 1.0})}, ("human.arrival",)),
     ("arrival-unknown", {"cell": _set("human.arrival", "sometimes")}, ("human.arrival",)),
+    ("stopping-and-stopping-time", {"cell": _set("robot.stopping", {"time": 0.2})},
+     ("robot", "stopping_time or a stopping block")),
+    ("stopping-category-9", {"cell": _stopping(category=9, time=0.2)}, ("robot.stopping.category",)),
+    ("stopping-data-without-payload", {"cell": _stopping(data="s.csv")}, ("robot.stopping", "payload_kg")),
+    ("stopping-data-fifo", {"cell": _stopping(data="s.csv", payload_kg=1.0), "setup": _fifo("in/s.csv")},
+     ("robot.stopping.data", "s.csv", "not a regular file")),
+    ("stopping-data-bad-category", {"cell": _stopping(data="s.csv", payload_kg=1.0), "setup": _write(
+        "in/s.csv", _STOP_HEAD + b"shoulder_pan_joint,7,100,5,100,0.3,rad,0.2\n")},
+     ("robot.stopping.data", "row 2, column 2 (category)")),
+    ("stopping-data-many-rows", {"cell": _stopping(data="s.csv", payload_kg=1.0), "setup": _write(
+        "in/s.csv", _STOP_HEAD + b"shoulder_pan_joint,1,100,5,100,0.3,rad,0.2\n" * 20_000)},
+     ("robot.stopping.data", "more than 10,000 rows")),
+    ("stopping-data-binary", {"cell": _stopping(data="s.csv", payload_kg=1.0),
+                              "setup": _write("in/s.csv", bytes(range(256)) * 64)}, ("robot.stopping.data",)),
+    ("stopping-data-below-program", {"cell": _stopping(data="s.csv", payload_kg=1.0), "setup": _write(
+        "in/s.csv", _STOP_HEAD + b"shoulder_pan_joint,1,10,5,100,0.3,rad,0.2\n")},
+     ("robot.stopping.data", "shoulder_pan_joint", "never extrapolated")),
     ("python-tag", {"cell_bytes": b"!!python/object/apply:os.system ['touch pwned']\n"}, ("cell.yaml",)),
     ("list-at-top", {"cell_bytes": b"- a\n- b\n"}, ("cell.yaml",)),
     # issue 29 (helper harden): rows counted whatever ends them, other files never quoted, clock windows, fields
@@ -507,6 +534,9 @@ BAD_RESULTS: list[tuple[str, dict, tuple[str, ...]]] = [
     ("action-unknown", {"result": _set("hazard.actions", ["walk+upright", "fly+upright"])}, ("fly+upright",)),
     ("phase-not-a-number", {"result": _set("hazard.actions", ["phase:nan", "walk+upright"])}, ("phase:nan",)),
     ("why-text", {"result": _set("hazard.why", "because")}, ("hazard.why",)),
+    ("severity-text", {"result": _set("hazard.severity.v_R", "fast")}, ("hazard.severity.v_R",)),
+    ("severity-negative", {"result": _set("hazard.severity.v_R", -1.0)}, ("hazard.severity.v_R",)),
+    ("severity-creeping-text", {"result": _set("hazard.severity.creeping", "no")}, ("hazard.severity.creeping",)),
     # issue 29 (helper harden): lists that disagree with the episodes, keys given twice, the files a cell read
     ("risks-600000", {"result": _risks(600_000)}, ("risk_per_episode", "600,000 values")),
     ("risks-one-short", {"result": lambda d: d.update(risk_per_episode=d["risk_per_episode"][:-1])},
@@ -535,6 +565,8 @@ FORGED: list[tuple[str, Callable[[dict], None], str]] = [
     ("risks", _set("risk_per_episode[0]", 1e-3), "risk_per_episode[0]"),
     ("cell-hash", _set("cell.sha256", "0" * 64), "cell.sha256"),
     ("why-late", _set("hazard.why.contact_at_s", 0.05), "hazard.why.contact_at_s"),
+    ("severity-milder", _set("hazard.severity.v_R", 0.001), "hazard.severity.v_R"),
+    ("severity-creeping", _set("hazard.severity.creeping", True), "hazard.severity.creeping"),
     ("searcher-unknown", _set("searcher", "<script>alert(1)</script>"), "searcher"),
     # issue 29 (helper harden): replay names the file that differs
     ("file-hash", _set("cell.files[1].sha256", "0" * 64), "cell.files"),

@@ -71,6 +71,7 @@ def check_lines(r) -> list[str]:
                        + ("" if b.ok else ": the robot restarts while the worker stands unseen within reach"))
         out += _reach_over_lines(b, z.cycle)
     out += [m.line() for m in r.mutings]
+    out += [s.line() for s in r.speeds]
     fails = r.failures()
     out.append("result: pass" if not fails else f"result: FAIL ({', '.join(fails)})")
     return out

@@ -6,7 +6,8 @@ The reasoning behind every number is in docs/cells.md. In short:
 * **Hazard zone.** The floor footprint of everything the robot sweeps in one cycle: the capsule axes, posed
   every ``SAMPLE_DT`` over the cycle (``kernels.robot_live``), projected on the floor and inflated by their
   radii ("stadiums"). ISO 13855 measures safety distances horizontally to this zone.
-* **ISO 13855 distances.** S = K T + C with T = device response + robot stopping time; each device kind gives
+* **ISO 13855 distances.** S = K T + C with T = device response + robot stopping time (its controller's delay
+  and its braking time, as the simulator brakes: ``robot.stopping``); each device kind gives
   its own (``Device.required_distance``: the laser scanner's horizontal field, the light curtain as a body
   detector). The actual distance is measured from where a worker enters the device's detection primitive:
   each edge of a scan plane's polygon a worker can step across (edges lying along a walk-blocking fence, the
@@ -49,11 +50,13 @@ from cellstress.analysis.plane import (
     rasterise_zone,
 )
 from cellstress.analysis.reach_over import HazardVolume, ReachOver, hazard_volume, panels_at, reach_over
+from cellstress.analysis.stopping import speed_checks
 from cellstress.cell.load import Cell, load_cell
 from cellstress.core.iso13857 import NO_BARRIER_BELOW_MM
 from cellstress.core.records import DoorLeaf, ScanPlane, VerticalField
 from cellstress.devices.base import DeviceRecord, stops_robot
 from cellstress.human.body import WALK_BLOCK_HEIGHT
+from cellstress.robot.stopping import RobotStop
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 from cellstress.sim.build import build_layout
@@ -157,6 +160,7 @@ class StaticCheck:
     robot_approaches: tuple[ApproachCheck, ...] = ()  # several robots: the undetected reach to robots 1..
     robot_cycles: tuple[tuple[str, float], ...] = ()  # several robots: each one's cycle time [s]
     mutings: tuple = ()  # analysis.muting.MutingCheck of every muted light curtain
+    speeds: tuple = ()  # analysis.stopping.SpeedCheck: each configured device speed against the robot's real one
 
     @property
     def ok(self) -> bool:
@@ -164,8 +168,8 @@ class StaticCheck:
 
     def failures(self) -> list[str]:
         """Names of the failed checks: device names, 'undetected-reach', 'reach-over' (ISO 13857 Table 2),
-        'DEVICE-restart', 'DEVICE-muting' (in a cell of several robots, with ':ROBOT' after a device's or the
-        reach checks' names)."""
+        'DEVICE-restart', 'DEVICE-muting', 'DEVICE-speed' (a configured speed below the robot's real one; in a
+        cell of several robots, with ':ROBOT' after a device's or the reach checks' names)."""
         out = [d.device + (f":{d.robot}" if d.robot else "") for d in self.devices if not d.ok]
         for a in (self.approach, *self.robot_approaches):
             if not a.ok:
@@ -174,6 +178,7 @@ class StaticCheck:
                 out.append("reach-over" + (f":{a.robot}" if a.robot else ""))
         out += [f"{r.device}-restart" for r in self.restarts if not r.ok]
         out += [f"{m.device}-muting" for m in self.mutings if not m.ok]
+        out += [f"{s.device}-speed" for s in self.speeds if not s.ok]
         return out
 
     def lines(self) -> list[str]:
@@ -231,10 +236,12 @@ def episode_length(spec) -> float:
     return sim.dt * sim.steps_per_action * sim.actions_per_episode
 
 
-def _device_checks(spec, zone: HazardZone, robot: str = "") -> tuple[DeviceCheck, ...]:
-    """Every device's ISO 13855 row; with ``robot`` (a cell of several robots), for that robot: its stopping time,
-    its hazard zone (``zone``), and ``spec.devices`` the devices that stop it."""
-    stop = spec.robot.stopping_time if not robot else next(r for r in spec.robots if r.name == robot).stopping_time
+def _device_checks(spec, zone: HazardZone, robot_stop: RobotStop, robot: str = "") -> tuple[DeviceCheck, ...]:
+    """Every device's ISO 13855 row, for the robot that stops as ``robot_stop`` says (the simulator's own delay and
+    braking: T = response + delay + braking); with ``robot`` (a cell of several robots), for that robot: its
+    hazard zone (``zone``), and ``spec.devices`` the devices that stop it."""
+    stop = robot_stop.to_standstill
+    delay, braking = robot_stop.delay, robot_stop.braking
     t_ep = episode_length(spec)
     fl = spec.floor
     floor_edges = [((fl.xmin, fl.ymin), (fl.xmax, fl.ymin)), ((fl.xmax, fl.ymin), (fl.xmax, fl.ymax)),
@@ -245,17 +252,17 @@ def _device_checks(spec, zone: HazardZone, robot: str = "") -> tuple[DeviceCheck
         covers += [(poly[i], poly[(i + 1) % len(poly)]) for i in range(len(poly))]
     out = []
     for d in spec.devices:
-        iso = d.required_distance(stop)
+        iso = d.stop_distance(delay, braking) if isinstance(d, DeviceRecord) else d.required_distance(stop)
         entries, actual, where, ep = _entries_to_zone(d.primitives(), covers, zone, t_ep)
         required = iso.S / 1000.0
         note = ""
         if isinstance(d, DeviceRecord):  # a device kind's own part (a guard door, speed and separation)
-            actual, note = d.static_check(actual, stop)
+            actual, note = d.stop_check(actual, delay, braking)
         out.append(DeviceCheck(d.name, d.type, d.response_time, stop, iso.T, iso.K, iso.C, required,
                                actual, bool(actual >= required - 1e-9), iso.formula, where,
                                tuple(entries), ep, any(isinstance(p, ScanPlane) for p in d.primitives()), robot,
                                note))
-        warn = d.warning_distance(stop) if isinstance(d, DeviceRecord) else None
+        warn = d.warning_stop_distance(delay, braking) if isinstance(d, DeviceRecord) else None
         if warn is not None:  # the warning field: measured like a field, against its own distance
             out.append(_warning_check(d, warn, stop, covers, zone, t_ep))
     return tuple(out)
@@ -451,13 +458,13 @@ def check_cell(cell: Cell | str | Path, layout=None) -> StaticCheck:
         devices, approaches = _per_robot(spec, layout, lean)
         approach, more = approaches[0], approaches[1:]
     else:
-        devices = _device_checks(spec, zone)
+        devices = _device_checks(spec, zone, layout.robots[0].stop)
         approach, more = _approach_check(spec, layout, zone, vol, panels, lean, ARM_ALLOWANCE), ()
     return StaticCheck(spec.name, zone, devices, approach, panels, shoulder, float(body[L.B_ARM_LEN]),
                        episode_length(spec), spec.human.arrival == "fixed",
                        _restart_checks(spec, layout, zone, vol, panels, lean), more,
                        tuple((p.name, float(p.trajectory.cycle)) for p in layout.robots) if more else (),
-                       muting_checks(spec))
+                       muting_checks(spec), speed_checks(layout))
 
 
 def _per_robot(spec, layout, lean: float) -> tuple[tuple[DeviceCheck, ...], list[ApproachCheck]]:
@@ -471,7 +478,7 @@ def _per_robot(spec, layout, lean: float) -> tuple[tuple[DeviceCheck, ...], list
         z = hazard_zone(layout, robot=r)
         mine = tuple(d for d in spec.devices if stops_robot(d, rs.name))
         sr = spec.model_copy(update={"devices": mine})
-        devices += _device_checks(sr, z, rs.name)
+        devices += _device_checks(sr, z, layout.robots[r].stop, rs.name)
         v = hazard_volume(layout, robot=r)
         a = _approach_check(sr, layout, z, v, _fence_panels(spec, z, v), lean, ARM_ALLOWANCE)
         approaches.append(replace(a, robot=rs.name, guards=tuple(d.name for d in mine)))

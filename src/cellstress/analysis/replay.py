@@ -72,6 +72,8 @@ def check_result(res: SearchResult, index: int | None = None, *, search_again: b
         computed = again.model_dump(by_alias=True)
         if listed.why is None:  # a file written before the timeline was recorded makes no claim about it
             computed["why"] = None
+        if listed.severity is None:  # ... nor one written before severities were
+            computed["severity"] = None
         problems += differences(listed.model_dump(by_alias=True), computed, prefix)
     if search_again and not problems:
         problems += _search_again(res, sim)
@@ -106,10 +108,14 @@ def _search_again(res: SearchResult, sim: Simulator) -> list[str]:
     for key in ("criterion", "files"):
         if key not in recorded["cell"]:
             rerun["cell"].pop(key, None)
+    old_distinct = recorded.get("distinct") or ()
+    if old_distinct and "severity" not in old_distinct[0] and rerun.get("distinct"):
+        rerun["distinct"].sort(key=lambda d: d["episode"])  # such files list the classes in the order found
     for old, new in zip((recorded.get("hazard"), *(recorded.get("distinct") or ())),
                         (rerun.get("hazard"), *(rerun.get("distinct") or ())), strict=False):
-        if isinstance(old, dict) and isinstance(new, dict) and "why" not in old:
-            new.pop("why", None)
+        for key in ("why", "severity"):
+            if isinstance(old, dict) and isinstance(new, dict) and key not in old:
+                new.pop(key, None)
     found = differences(recorded, rerun, "")
     if not found:
         return []

@@ -1,6 +1,7 @@
 """Every file a cell reads, with its size and SHA-256, and the rule for files outside the cell's folder.
 
-A cell reads its own file, each robot's URDF, the collision meshes that URDF names and any trajectory file. A
+A cell reads its own file, each robot's URDF, the collision meshes that URDF names, any trajectory file and any
+stopping data file. A
 robot from elsewhere is legitimate (a ROS package, example-robot-data), so by default a cell may read any file;
 but none unseen: ``cellstress check`` lists them all (marking those outside the cell's folder) and result files
 record them, so ``replay`` names the input that changed. ``CELLSTRESS_FILES=inside`` makes the rule strict: a
@@ -18,6 +19,7 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from cellstress.cell.program import trajectory_path
+from cellstress.cell.robot_stop import stopping_data_path
 from cellstress.core.errors import CellError, CellstressError
 from cellstress.core.io import InputFileError, file_digest
 from cellstress.core.provenance import MAX_FILES, InputFile
@@ -90,7 +92,7 @@ def _robots(cell) -> list[tuple[str, object]]:
 
 
 def robot_reads(cell) -> list[Read]:
-    """The URDF and trajectory file of every robot, before either is read."""
+    """The URDF, trajectory file and stopping data file of every robot, before any is read."""
     out = []
     for where, rs in _robots(cell):
         urdf = resolve_urdf(rs.urdf, cell.files_dir)
@@ -98,6 +100,9 @@ def robot_reads(cell) -> list[Read]:
         if rs.task.trajectory_csv:
             csv = trajectory_path(rs.task.trajectory_csv, cell.files_dir)
             out.append(Read(f"{where}.task.trajectory_csv", csv, _outside(cell, csv)))
+        if rs.stopping is not None and rs.stopping.data is not None:
+            data = stopping_data_path(rs.stopping.data, cell.files_dir)
+            out.append(Read(f"{where}.stopping.data", data, _outside(cell, data)))
     return out
 
 

@@ -17,6 +17,7 @@ from pydantic import BaseModel, ValidationError
 
 from cellstress.cell.files import cell_files, refuse_files_outside
 from cellstress.cell.program import robot_program
+from cellstress.cell.robot_stop import check_hold, robot_stop
 from cellstress.cell.schema import CRITERIA, DEVICE_KINDS, CellSpec
 from cellstress.core import registry
 from cellstress.core.errors import CellError, CellstressError
@@ -36,7 +37,8 @@ BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intr
                                   "warning-field-ok", "mat-short", "mat-ok", "palletizing", "palletizing-fixed",
                                   "door-unlocked", "door-locked", "muting-long", "muting-ok",
                                   "two-robots", "two-robots-fixed", "ssm-latency", "ssm-ok", "reach-over",
-                                  "reach-over-ok", "long-gripper", "long-gripper-ok", "machine-tending")
+                                  "reach-over-ok", "long-gripper", "long-gripper-ok", "machine-tending",
+                                  "machine-tending-delay", "machine-tending-delay-ok")
 
 
 @dataclass(frozen=True)
@@ -377,11 +379,13 @@ def _check_robot(cell: Cell, rs, where: str) -> float:
         raise CellError(src, f"{where}.urdf", f"pinocchio cannot read it: {str(exc).splitlines()[0]}") from None
     _check_shapes(cell, rs, where, urdf, robot)
     try:
-        cycle = robot_program(src, robot, rs, cell.files_dir).cycle
+        traj = robot_program(src, robot, rs, cell.files_dir)
     except CellError as exc:  # the program's messages name the field from "robot."
         if where == "robot" or not exc.field.startswith("robot."):
             raise
         raise CellError(src, where + exc.field.removeprefix("robot"), exc.problem) from None
+    if robot_stop(src, where, rs, robot, traj, cell.files_dir).hold:
+        check_hold(cell, where)
     caps = rs.capsules if rs.capsules != "auto" else ()
     for i, c in enumerate(tuple(caps) + rs.extra_capsules):
         if c.link not in robot.link_joint:
@@ -389,7 +393,7 @@ def _check_robot(cell: Cell, rs, where: str) -> float:
                      else f"{where}.extra_capsules[{i - len(caps)}].link")
             raise CellError(src, field, f"the robot has no link {c.link!r}; its links are "
                                         f"{', '.join(sorted(robot.link_joint))}")
-    return float(cycle)
+    return float(traj.cycle)
 
 
 def _check_clock_windows(cell: Cell, cycle: float) -> None:

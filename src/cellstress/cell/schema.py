@@ -23,6 +23,7 @@ from pydantic import (
 
 from cellstress.cell.arrival import MAX_CYCLE, ArrivalField, ArrivalWindow  # noqa: F401  (part of the schema)
 from cellstress.cell.obstacles import BoxFootprint, ObstacleSpec  # noqa: F401  (part of the schema)
+from cellstress.cell.stopping import StoppingSpec
 from cellstress.core import registry
 from cellstress.core.fields import (
     MAX_EXTENT,
@@ -214,7 +215,10 @@ class RobotSpec(Record):
     extra_capsules: tuple[CapsuleSpec, ...] = Field((), max_length=MAX_CAPSULES)
     """Capsules added to the robot's own, e.g. a gripper holding a part."""
     stopping_time: PositiveTime = 0.15
-    """Time [s] from the stop signal to standstill, braking along the path."""
+    """Time [s] from the stop signal to standstill, braking along the path (category 1, no delay; the paper's)."""
+    stopping: StoppingSpec | None = None
+    """How the robot stops, instead of ``stopping_time``: stop category, controller delay, braking time or the
+    maker's stopping data (docs/robot.md, Stopping)."""
     pedestal: Literal["auto", "none"] = "auto"
     """auto: the robot's base (the shapes of the links that do not move, in plan, from the floor up to their top)
     is an obstacle the worker cannot walk or lean into; none: nothing below the base (a robot hung from above)."""

@@ -92,6 +92,7 @@ def _robot_lines(part, files_dir, several: bool) -> None:
     """The robot, its capsules and its program (in a cell of several robots, each headed by its name)."""
     import numpy as np
 
+    from cellstress.analysis.stopping import stop_lines
     from cellstress.robot.model import resolve_urdf
 
     out, rs, robot, caps, traj = say, part.spec, part.model, part.capsules, part.trajectory
@@ -105,7 +106,9 @@ def _robot_lines(part, files_dir, several: bool) -> None:
     follow = [f"{n} {what}" for n, what in ((len(rs.hold), "held"), (n_mimic, "mimic")) if n]
     joints = f"{robot.n_joints} joints" + (f" ({', '.join(follow)})" if follow else "")
     out(f"            {joints}, base at ({', '.join(num(v) for v in base.xyz)}) "
-        f"yaw {num(base.yaw_deg)} deg, stopping time {num(rs.stopping_time)} s")
+        f"yaw {num(base.yaw_deg)} deg, stopping time {part.stop.describe()}")
+    for line in stop_lines(part.stop, part.model, part.capsules):
+        out(f"            {line}")
     extra = f" + {len(caps) - n_own} extra" if len(caps) > n_own else ""
     out(f"capsules    {len(caps)} ({n_own} {cap_kind}{extra})")
     for k in caps:

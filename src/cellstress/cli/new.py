@@ -20,6 +20,17 @@ HEADER = """\
 """
 
 
+# How the robot stops: to be filled in from the robot's own manual. The values are the paper's placeholder.
+STOPPING = """\
+  stopping:   # FILL IN from the robot's manual: these values are a placeholder (the paper's), not your robot's
+    category: 1            # IEC 60204-1 stop category of its protective stop: 0, 1 or 2 (the manual says which)
+    controller_delay: 0.0  # s from the stop signal at the robot to the start of braking not in the maker's data
+                           # (a safety PLC or a network in between)
+    time: 0.15             # s of braking to standstill; or the maker's stopping distances and times per joint
+                           # (ISO 10218-1 Annex B, in the manual): data: FILE.csv with payload_kg (docs/robot.md)
+"""
+
+
 def robot_block(short_name: str) -> str:
     """The ``robot:`` section of a starter cell for a built-in robot: joint waypoints derived from its joint
     limits (the middle of every range, then the first joint turned by a quarter of its range, at most 90 deg),
@@ -43,12 +54,12 @@ def robot_block(short_name: str) -> str:
         return "[" + ", ".join(f"{round(user_value(robot, j, q[j]), digits[j]):g}" for j in jmap.driven) + "]"
 
     names = textwrap.fill(", ".join(jmap.driven_names), 100, initial_indent="    # ", subsequent_indent="    # ")
+    stopping = STOPPING
     return f"""robot:
   urdf: {short_name}
   base: {{xyz: [0.0, 0.0, 0.85], yaw_deg: 0.0}}
   capsules: auto
-  stopping_time: 0.15
-  task:
+{stopping}  task:
     # one value per joint the program drives, in degrees (metres for a prismatic joint):
 {names}
     # A starting point within the joint limits: replace it by the cell's own program (or give tool poses:
@@ -96,6 +107,7 @@ def new(
         with user_errors():
             block = robot_block(robot)
         body = body[:body.index("robot:\n")] + block + body[body.index("table:\n"):]
+    body = body.replace("  stopping_time: 0.15\n", STOPPING, 1)  # (the UR10's; another robot's block has it)
     body = body.replace("name: baseline\n", f"name: {yaml.safe_dump(name).splitlines()[0]}\n", 1)
     # a new cell is searched over the robot's whole cycle (the built-in keeps the paper's fixed arrival)
     body = re.sub(r"(?m)^  arrival: fixed .*$", "  arrival: cycle    # any moment of the robot's cycle, chosen by the "

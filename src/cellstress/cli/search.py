@@ -74,11 +74,13 @@ def search(
     from cellstress.analysis.shortfall import shortfall
     from cellstress.cell.load import load_cell, with_criterion
     from cellstress.cli.report import after_search
+    from cellstress.criteria.iso15066 import CREEP_SPEED
     from cellstress.report.scope import NOT_A_PROOF, judged_by, search_scope, strongest_contact
     from cellstress.searchers import make_searcher, parse_options
     from cellstress.searchers import search as run
     from cellstress.searchers.common import check_common
     from cellstress.searchers.distinct import link_group, root_cause
+    from cellstress.searchers.severity import words as severity_words
     from cellstress.sim.compiling import watching
     from cellstress.sim.simulator import Simulator
 
@@ -165,30 +167,41 @@ def search(
              f"{elapsed:.2f} s, {rate:.0f} episodes/s)")
         echo(f"actions   {', '.join(h.actions)}")
         x, y, z = h.point
+        creep = " (creeping)" if h.severity is not None and h.severity.creeping else ""
         echo(f"contact   t={num(h.time_s)} s (step {h.step}): {h.robot_link} / {h.body_part} at "
-             f"({x:.3f}, {y:.3f}, {z:.3f}) m, robot moving at v_R {h.v_R:.3f} m/s")
+             f"({x:.3f}, {y:.3f}, {z:.3f}) m, robot moving at v_R {h.v_R:.3f} m/s{creep}")
         if h.why is not None:
             echo(f"why       {shortfall(h.why, static)}")
         if h.verdict is not None:  # a criterion that judges contacts: its account of this one
             name, numbers = h.verdict
             echo(f"{name:<9} {numbers.get('reason')}")
-    causes: dict[tuple[str, str], list[int]] = {}
-    for i, d in enumerate(result.distinct or ()):
-        causes.setdefault(root_cause(d.klass), []).append(i)
-    for n, ((device, area), members) in enumerate(causes.items(), start=1):
-        failed = "no device saw the worker" if device == "none" else f"{device} stopped the robot too late"
-        echo(f"cause {n}   {failed}; {area} touched ({len(members)} {'class' if len(members) == 1 else 'classes'})")
-        first = result.distinct[members[0]]
-        if first.why is not None:
-            echo(f"  why     {shortfall(first.why, static)}")
-        for i in members:
-            d = result.distinct[i]
-            cls = d.klass
-            x0, y0, x1, y1 = cls.approach_cell
-            move = "" if cls.robot_move is None else f", robot's move {cls.robot_move}"
-            echo(f"  class {i}  episode {d.episode}: {cls.robot_link} ({link_group(sim.layout, cls.robot_link)}) / "
-                 f"{cls.body_region}, worker at x {num(x0)}..{num(x1)}, y {num(y0)}..{num(y1)}{move}  "
-                 f"(cellstress replay {path} --hazard {i})")
+    # the classes come worst first (searchers.severity); those while the robot creeps are shown apart, after
+    listed = list(enumerate(result.distinct or ()))
+    n = 0
+    for creeping in (False, True):
+        group = [i for i, d in listed if (d.severity is not None and d.severity.creeping) == creeping]
+        if creeping and group:
+            echo(f"creeping  contacts while the robot moves slower than {CREEP_SPEED:.3f} m/s (no transient contact "
+                 "can exceed an ISO/TS 15066 limit but the head's), listed apart:")
+        causes: dict[tuple[str, str], list[int]] = {}
+        for i in group:
+            causes.setdefault(root_cause(result.distinct[i].klass), []).append(i)
+        for (device, area), members in causes.items():
+            n += 1
+            failed = "no device saw the worker" if device == "none" else f"{device} stopped the robot too late"
+            echo(f"cause {n}   {failed}; {area} touched ({len(members)} "
+                 f"{'class' if len(members) == 1 else 'classes'})")
+            first = result.distinct[members[0]]
+            if first.why is not None:
+                echo(f"  why     {shortfall(first.why, static)}")
+            for i in members:
+                d = result.distinct[i]
+                cls = d.klass
+                x0, y0, x1, y1 = cls.approach_cell
+                move = "" if cls.robot_move is None else f", robot's move {cls.robot_move}"
+                echo(f"  class {i}  episode {d.episode}: {cls.robot_link} ({link_group(sim.layout, cls.robot_link)}) "
+                     f"/ {cls.body_region}, worker at x {num(x0)}..{num(x1)}, y {num(y0)}..{num(y1)}{move}, "
+                     f"{severity_words(d.severity)}  (cellstress replay {path} --hazard {i})")
     if report:
         echo(report)
     echo(f"wrote     {path}")

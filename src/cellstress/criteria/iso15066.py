@@ -53,6 +53,18 @@ def transient_limit(region: str) -> float:
     return TRANSIENT_FACTOR * REGIONS[region][0]
 
 
+def creep_speed() -> float:
+    """The robot speed [m/s] below which no transient contact exceeds its ISO/TS 15066 limit on any body region
+    but the head, however heavy the robot: F = v sqrt(mu k) <= v sqrt(m_H k) (mu < m_H), so the least of
+    2 F_qs / sqrt(m_H k) over those regions (Tables A.2 and A.3; the lower legs' 0.123 m/s). Results list contacts
+    slower than this apart, after the others (docs/criteria.md)."""
+    return min(transient_limit(r) / math.sqrt(m * k * 1000.0) for r, (_, k, m) in REGIONS.items()
+               if r not in HEAD_REGIONS)
+
+
+CREEP_SPEED = creep_speed()
+
+
 def peak_force(v_rel: float, m_robot: float, m_human: float, k_n_per_m: float) -> float:
     """Peak transient force F = v sqrt(mu k) of a fully inelastic contact (ISO/TS 15066 A.3)."""
     if v_rel <= 0.0:

@@ -65,6 +65,24 @@ class DeviceRecord(Record):
         separation monitor its configured protective separation."""
         return distance, ""
 
+    # How the robot stops, in two parts (docs/robot.md, Stopping): after the stop signal reaches it, it keeps its
+    # speed for ``delay`` seconds (its controller's delay), then brakes to a standstill over ``braking``. ISO
+    # 13855's S = K T + C counts only the time, T = response + delay + braking, so by default a kind sees the sum
+    # (its ``stopping_time``); a kind whose distance depends on how the robot moves meanwhile (a warning field's
+    # reduced speed, speed and separation monitoring) overrides these.
+    def stop_distance(self, delay: float, braking: float) -> IsoDistance:
+        """ISO 13855 distance for a robot that keeps its speed ``delay`` s after the signal, then brakes over
+        ``braking`` s."""
+        return self.required_distance(delay + braking)
+
+    def warning_stop_distance(self, delay: float, braking: float) -> IsoDistance | None:
+        """``warning_distance`` for such a robot."""
+        return self.warning_distance(delay + braking)
+
+    def stop_check(self, distance: float, delay: float, braking: float) -> tuple[float, str]:
+        """``static_check`` for such a robot."""
+        return self.static_check(distance, delay + braking)
+
 
 def stops_of(device) -> tuple[str, ...] | None:
     """The robot names a device's stop is limited to (``DeviceRecord.stops``); None: every robot (also for a

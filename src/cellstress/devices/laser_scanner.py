@@ -35,6 +35,10 @@ class WarningField(Record):
     restart: Restart = "manual"
     """How the reduction is released: ``manual`` (for the rest of the episode) or ``{automatic: CLEAR_TIME}``
     (full speed again once the warning field has not seen the worker for CLEAR_TIME seconds)."""
+    speed_limit: Annotated[float, Field(gt=0.0, le=10.0, allow_inf_nan=False)] | None = None
+    """The robot speed [m/s] the reduced speed was laid out for (e.g. the speed the risk assessment allows near
+    the protective field); ``check`` fails where ``reduced_speed`` times the robot's real top speed on its
+    program exceeds it. Absent: not checked."""
 
 
 def _c(height_mm: float) -> float:
@@ -87,32 +91,43 @@ class LaserScanner(DeviceRecord):
                                 self.response_time, clear),)
 
     def required_distance(self, stopping_time: float) -> IsoDistance:
+        return self.stop_distance(0.0, stopping_time)
+
+    def stop_distance(self, delay: float, braking: float) -> IsoDistance:
+        """S = 1600 T + C; behind a warning field the robot brakes from the reduced speed r, in r * braking (its
+        controller's delay stays whole)."""
+        stopping_time = braking
         height_mm = self.height * 1000.0
         c = _c(height_mm)
         c_text = (f"(1200 - 0.4*{mm(height_mm)})" if c == 1200.0 - 0.4 * height_mm else
                   "850 (C = 1200 - 0.4 H is below 850)")
         if self.warning is not None:  # behind a warning field: the robot brakes from the reduced speed
             r = self.warning.reduced_speed
-            T = self.response_time + r * stopping_time
+            T = self.response_time + delay + r * stopping_time
             s = K_WALK * T + c
-            return IsoDistance(K_WALK, T, c, s, f"at the reduced speed {r:g}: S = 1600*({self.response_time:g} + "
-                                                f"{r:g}*{stopping_time:g}) + {c_text} = {mm(s)} mm")
-        T = self.response_time + stopping_time
+            wait = f" + {delay:g}" if delay > 0.0 else ""
+            return IsoDistance(K_WALK, T, c, s, f"at the reduced speed {r:g}: S = 1600*({self.response_time:g}"
+                                                f"{wait} + {r:g}*{stopping_time:g}) + {c_text} = {mm(s)} mm")
+        T = self.response_time + delay + stopping_time
         s = K_WALK * T + c
         return IsoDistance(K_WALK, T, c, s, f"S = 1600*{T:.2f} + {c_text} = {mm(s)} mm")
 
     def warning_distance(self, stopping_time: float) -> IsoDistance | None:
+        return self.warning_stop_distance(0.0, stopping_time)
+
+    def warning_stop_distance(self, delay: float, braking: float) -> IsoDistance | None:
         """The warning field's distance: the protective field's S at the reduced speed plus the lead the
-        reduction needs to take full effect, K * (response + (1 - r) * stopping time)."""
+        reduction needs to take full effect, K * (response + delay + (1 - r) * braking)."""
         if self.warning is None:
             return None
         r = self.warning.reduced_speed
-        prot = self.required_distance(stopping_time)
-        lead_t = self.response_time + (1.0 - r) * stopping_time
+        prot = self.stop_distance(delay, braking)
+        lead_t = self.response_time + delay + (1.0 - r) * braking
         s = prot.S + K_WALK * lead_t
+        wait = f" + {delay:g}" if delay > 0.0 else ""
         return IsoDistance(K_WALK, prot.T + lead_t, prot.C, s,
-                           f"S = {mm(prot.S)} (protective, reduced speed) + 1600*({self.response_time:g} + "
-                           f"(1 - {r:g})*{stopping_time:g}) = {mm(s)} mm")
+                           f"S = {mm(prot.S)} (protective, reduced speed) + 1600*({self.response_time:g}{wait} + "
+                           f"(1 - {r:g})*{braking:g}) = {mm(s)} mm")
 
     def describe(self) -> str:
         text = f"{len(self.polygon)}-point field at {self.height:g} m"

@@ -120,9 +120,13 @@ class SpeedSeparation(DeviceRecord):
                               self.stopping_time, self.allowance)
 
     def required_distance(self, stopping_time: float) -> IsoDistance:
-        """S_p at full speed with the REAL times (this record's response time, the robot's stopping time), as an
-        assessor computes it: K = v_h, T = T_r + T_s, C = v_max (T_r + T_s / 2) + C + Z_d + Z_r [mm]."""
-        t_r, v_h, v = self.response_time, self.human_speed, self.max_speed
+        return self.stop_distance(0.0, stopping_time)
+
+    def stop_distance(self, delay: float, braking: float) -> IsoDistance:
+        """S_p at full speed with the REAL times (T_r: this record's response time and the robot's controller
+        delay; T_s: the robot's braking time), as an assessor computes it: K = v_h, T = T_r + T_s,
+        C = v_max (T_r + T_s / 2) + C + Z_d + Z_r [mm]."""
+        t_r, v_h, v, stopping_time = self.response_time + delay, self.human_speed, self.max_speed, braking
         s = protective_separation(v_h, v, t_r, stopping_time, self.allowance)
         rest = s - v_h * (t_r + stopping_time)
         text = (f"S_p = {v_h:g}*({t_r:g} + {stopping_time:g}) + {v:g}*{t_r:g} + {v:g}*{stopping_time:g}/2 + "
@@ -130,15 +134,20 @@ class SpeedSeparation(DeviceRecord):
         return IsoDistance(v_h * 1000.0, t_r + stopping_time, rest * 1000.0, s * 1000.0, text)
 
     def static_check(self, distance: float, stopping_time: float) -> tuple[float, str]:
+        return self.stop_check(distance, 0.0, stopping_time)
+
+    def stop_check(self, distance: float, delay: float, braking: float) -> tuple[float, str]:
         """This kind's part of the static check (analysis.iso13855 asks any device that has it): full speed is
         allowed down to the controller's own S_p, so the separation guaranteed is the lesser of the area's
         ``distance`` and that (docs/cells.md); the note names the configured times."""
-        return min(distance, self.configured_separation()), self.configured_note(stopping_time)
+        return min(distance, self.configured_separation()), self.configured_note(braking, delay)
 
-    def configured_note(self, stopping_time: float) -> str:
-        """The controller's own S_p at full speed, and which configured time is shorter than the real one."""
+    def configured_note(self, stopping_time: float, delay: float = 0.0) -> str:
+        """The controller's own S_p at full speed, and which configured time is shorter than the real one (T_r:
+        the response time and the robot's controller delay; T_s: its braking time)."""
         short = [f"{what} {cfg:g} s < real {real:g} s" for what, cfg, real in
-                 (("T_r", self.reaction_time, self.response_time), ("T_s", self.stopping_time, stopping_time))
+                 (("T_r", self.reaction_time, self.response_time + delay),
+                  ("T_s", self.stopping_time, stopping_time))
                  if cfg < real - 1e-12]
         head = (f"configured: T_r {self.reaction_time:g} s, T_s {self.stopping_time:g} s: full speed down to "
                 f"S_p = {mm(self.configured_separation() * 1000.0)} mm (the actual separation is the lesser of it "

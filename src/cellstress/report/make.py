@@ -23,6 +23,7 @@ from cellstress.report.story import Account, account
 from cellstress.report.view3d import STYLE as VIEW3D_STYLE
 from cellstress.report.view3d import view_fragment, view_page
 from cellstress.searchers.result import FILE_NAME, SearchResult
+from cellstress.searchers.severity import words as severity_words
 
 NAMES = ("topview.png", "contact.png", "replay.gif", "risk.png", "program.png", "report.html")
 
@@ -159,6 +160,9 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
         verdict = (f"<b>Hazard found</b> at episode {h.episode} of {res.budget} ({e(res.searcher)}, seed "
                    f"{res.seed}): {e(str(h.robot_link))} / {e(str(h.body_part))} at t = {h.time_s:.2f} s, "
                    f"v_R = {h.v_R:.2f} m/s.")
+        sev = h.severity
+        if sev is not None and (sev.creeping or sev.force_ratio is not None):  # (v_R is its speed, shown above)
+            verdict += f" Severity: {e(severity_words(sev))}."
         if h.verdict is not None:
             name, numbers = h.verdict
             verdict += f" {e(name)}: {e(str(numbers.get('reason')))}."
@@ -224,8 +228,8 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
         ["episode shown", f"{view.episode} ({'first hazard' if view.kind == 'hazard' else 'riskiest kept'})"],
         ["simulation", f"dt {spec.simulation.dt:g} s, {spec.simulation.steps_per_action} steps per action, "
                        f"{spec.simulation.actions_per_episode} actions per episode"],
-        ["robot stopping time", f"{spec.robot.stopping_time:g} s" if len(spec.robots) == 1 else
-         ", ".join(f"{r.name} {r.stopping_time:g} s" for r in spec.robots)],
+        ["robot stopping time", view.layout.robots[0].stop.describe() if len(spec.robots) == 1 else
+         ", ".join(f"{p.name} {p.stop.describe()}" for p in view.layout.robots)],
         ["devices", "; ".join(f"{d.name} ({d.type}, response {d.response_time:g} s)" for d in spec.devices) or "-"],
         ["replay", "agrees bit-exactly with result.json" if view.matches_file else
          ("no trace in result.json (riskiest episode replayed)" if view.matches_file is None else "DIFFERS")],

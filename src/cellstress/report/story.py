@@ -115,8 +115,9 @@ def account(view: EpisodeView, episodes: int | None = None) -> Account:
     if phase == "stop-pending" and stop:
         phase_text = f"a stop requested by '{stop[1]}' takes effect only at t = {stop[0]:.2f} s"
     elif phase == "braking" and stop:
-        phase_text = (f"the robot has been braking since t = {stop[0]:.2f} s and would stand still at "
-                      f"t = {stop[0] + touched_robot(view.layout, hit).spec.stopping_time:.2f} s")
+        rs = touched_robot(view.layout, hit).stop
+        phase_text = (f"the robot has been braking since t = {stop[0] + rs.delay:.2f} s and would stand still at "
+                      f"t = {stop[0] + rs.to_standstill:.2f} s")
     else:
         phase_text = _PHASES.get(phase, phase)
     moves = ", ".join(view.layout.worker.action_words(a, short=True) for a in view.actions)

@@ -16,6 +16,7 @@ from cellstress.report.episode import replay
 from cellstress.report.scene3d import view_of_episodes
 from cellstress.report.view3d import STYLE as VIEW3D_STYLE
 from cellstress.report.view3d import view_fragment
+from cellstress.searchers.severity import words as severity_words
 from cellstress.verifier.records import PROVED_SAFE, UNDECIDED, UNSAFE, VerifyResult
 
 PNG_NAME = "verify.png"
@@ -132,8 +133,9 @@ def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None
         failed = "no device saw the worker" if k.device == "none" else f"{k.device} stopped the robot too late"
         where = f"{out}/{w.file}" if out else w.file
         x0, y0, x1, y1 = k.approach_cell
+        sev = "" if w.severity is None else f"; {severity_words(w.severity)}"
         lines.append(f"class {i:<3} {failed}; {k.robot_link} / {k.body_region}, worker at x {x0:g}..{x1:g}, "
-                     f"y {y0:g}..{y1:g}; {w.sequences:,} sequences; first at "
+                     f"y {y0:g}..{y1:g}{sev}; {w.sequences:,} sequences; first at "
                      f"{w.start}, phase {w.phase:g} s: {', '.join(w.actions)}")
         lines.append(f"          cellstress replay {where}")
     return lines
@@ -173,12 +175,14 @@ def verify_page(res: VerifyResult, png: str | Path, path: str | Path, criterion_
                       f"{sum(s.states):,}"] for s in res.subtrees if s.verdict != PROVED_SAFE]
                     or [["(every sub-tree proved safe)", "", "", "", "", "", "", "", "", ""]],
                     numeric={1, 3, 4, 5, 6, 7, 8, 9})]
-    if res.classes:
+    if res.classes:  # worst first (searchers.severity)
         body += ["<h2>Hazard classes and their witnesses</h2>",
-                 H.table(["class", "device", "robot link / body region", "sequences", "witness", "file"],
-                         [[i, w.klass.device, f"{w.klass.robot_link} / {w.klass.body_region}", f"{w.sequences:,}",
-                           ", ".join(w.actions), w.file] for i, w in enumerate(res.classes, start=1)],
-                         numeric={0, 3})]
+                 H.table(["class", "device", "robot link / body region", "severity", "sequences", "witness",
+                          "file"],
+                         [[i, w.klass.device, f"{w.klass.robot_link} / {w.klass.body_region}",
+                           severity_words(w.severity), f"{w.sequences:,}", ", ".join(w.actions), w.file]
+                          for i, w in enumerate(res.classes, start=1)],
+                         numeric={0, 4})]
     if view3d:
         shown = min(len(res.classes), MAX_WITNESS_VIEWS)
         body += ["<h2>Witnesses in 3D</h2>",

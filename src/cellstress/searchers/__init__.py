@@ -35,6 +35,7 @@ from cellstress.searchers.result import (
     SearchResult,
     TopEpisode,
 )
+from cellstress.searchers.severity import severity, worst_first
 from cellstress.searchers.slices import ClassRecorder, cell_starts, run_slices
 from cellstress.searchers.why import explain
 from cellstress.sim.simulator import Simulator
@@ -180,9 +181,9 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
         distinct_sequences=out.distinct_sequences,
         version=__version__,
         format=FORMAT,
-        distinct=None if rec is None else tuple(
+        distinct=None if rec is None else tuple(worst_first([
             distinct_record(sim, hazard_class_record(key), episode, names(actions))
-            for key, (episode, actions) in rec.classes.items()),
+            for key, (episode, actions) in rec.classes.items()])),
     )
 
 
@@ -203,6 +204,7 @@ def hazard_record(sim: Simulator, episode: int, actions: list[str]) -> Hazard:
         episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.t, robot_link=hit.robot_link,
         body_part=hit.body_part, point=hit.robot_point, human_point=hit.human_point, v_R=hit.v_R, d_HR=hit.d_HR,
         trace=records, why=explain(trace.layout, records, trace.unsafe_row),
+        severity=severity(hit.v_R, None if verdict is None else verdict.as_dict()),
         **({} if verdict is None else {sim.criterion.type: verdict.as_dict()}))
 
 
@@ -210,7 +212,9 @@ def distinct_record(sim: Simulator, klass, episode: int, actions: list[str]) -> 
     """The record of a distinct class's first hazard (see ``hazard_record``)."""
     trace, records = _unsafe_row(sim, actions)
     hit = records[trace.unsafe_row]
+    verdict = sim.verdict(trace.rows[trace.unsafe_row])
     return DistinctHazard.model_construct(
         klass=klass, episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.t,
         robot_link=hit.robot_link, body_part=hit.body_part, v_R=hit.v_R, trace=records,
-        why=explain(trace.layout, records, trace.unsafe_row))
+        why=explain(trace.layout, records, trace.unsafe_row),
+        severity=severity(hit.v_R, None if verdict is None else verdict.as_dict()))

@@ -99,7 +99,8 @@ class DeviceTiming(Record):
     saw_at_s: float | None
     """First time the device saw the worker [s]; None: never, up to the contact."""
     stop_at_s: float | None
-    """When the stop it asked for took effect (saw_at_s plus its response time) [s]."""
+    """When the stop it asked for took effect (saw_at_s plus its response time): its signal reached the robot [s].
+    The robot begins to brake after its controller's delay (``Why.braking_from_s``)."""
 
 
 class Why(Record):
@@ -132,6 +133,28 @@ class Why(Record):
         return out
 
 
+class Severity(Record):
+    """How bad a hazard's contact is (``searchers.severity``): the robot's speed there and, under a criterion that
+    judges forces (iso15066), the predicted force over its limit; ``creeping``: the robot slower than
+    ``criteria.iso15066.CREEP_SPEED`` (no transient contact can exceed a limit but the head's). Findings are
+    listed worst first, creeping ones after the others."""
+
+    v_R: Annotated[float, Field(ge=0.0, le=1000.0)]
+    """The robot's speed at the contact [m/s] (the simulator's v_R: its fastest joint)."""
+    force_ratio: Annotated[float, Field(ge=0.0, le=1e9)] | None = None
+    """The predicted peak force over the body region's transient limit (iso15066; a head contact while the robot
+    moves counts at least 1); absent for other criteria."""
+    creeping: bool
+    """v_R below the creep speed: shown apart, after the others."""
+
+    @model_serializer(mode="wrap")
+    def _drop_absent(self, handler):
+        out = handler(self)
+        if out.get("force_ratio") is None:
+            out.pop("force_ratio", None)
+        return out
+
+
 class Hazard(Record):
     """The first hazardous episode: its actions, the unsafe step and its trace. A criterion that judges contacts
     adds its verdict under the criterion's name (e.g. ``iso15066``): the one field not declared here."""
@@ -150,6 +173,7 @@ class Hazard(Record):
     d_HR: float | None
     trace: Trace
     why: Why | None = None  # absent from files written before it was recorded
+    severity: Severity | None = None  # absent from files written before it was recorded
 
     @model_validator(mode="after")
     def _one_verdict(self) -> Hazard:
@@ -182,6 +206,7 @@ class DistinctHazard(Record):
     v_R: float | None
     trace: Trace
     why: Why | None = None  # absent from files written before it was recorded
+    severity: Severity | None = None  # absent from files written before it was recorded
 
 
 class SearchResult(Record):
@@ -204,7 +229,8 @@ class SearchResult(Record):
     distinct_sequences: Annotated[int, Field(ge=0, le=MAX_EPISODES)] | None = None
     version: Name
     format: Literal[1] = FORMAT
-    # distinct mode only (absent from the file otherwise): the first hazard of each class, in the order found
+    # distinct mode only (absent from the file otherwise): the first hazard of each class, worst first (creeping
+    # contacts last; ties in the order found: searchers.severity)
     distinct: Annotated[tuple[DistinctHazard, ...], Field(max_length=MAX_LISTED)] | None = None
 
     @model_validator(mode="after")
@@ -237,8 +263,9 @@ class SearchResult(Record):
             if d["class"]["robot_move"] is None:
                 del d["class"]["robot_move"]
         for h in (doc["hazard"], *(doc.get("distinct") or ())):
-            if h is not None and h.get("why", 0) is None:
-                del h["why"]
+            for key in ("why", "severity"):
+                if h is not None and h.get(key, 0) is None:
+                    del h[key]
         if doc["cell"]["criterion"] is None:
             del doc["cell"]["criterion"]
         return json_ready(doc)

@@ -100,7 +100,7 @@ def _muting_words(layout, records) -> list[str]:
 def _door_words(name: str, opening: float, locked: bool, pushed: float, first_stop: float | None, layout) -> str:
     """A guard door's part of the timeline: when it was pushed, when it let the worker through, and how that
     compares with the robot's rest (its first stop plus the stopping time)."""
-    rest = None if first_stop is None else _r(first_stop + float(layout.cell.spec.robot.stopping_time))
+    rest = None if first_stop is None else _r(first_stop + float(layout.robots[0].stop.to_standstill))
     if locked:
         return f"{name} was pushed at {pushed:.2f} s and stayed locked until the robot was at rest ({rest:.2f} s)"
     through = _r(pushed + opening)
@@ -126,7 +126,7 @@ def explain(layout, records, unsafe_row: int) -> Why:
     spec = layout.cell.spec
     words = safeguard_words(layout, records, unsafe_row)
     robot = touched_robot(layout, records[unsafe_row])
-    stopping_time = spec.robot.stopping_time if robot is None else robot.spec.stopping_time
+    stop = (layout.robots[0] if robot is None else robot).stop  # its delay before braking, then its braking
     if len(layout.robots) > 1:
         others = [d.name for d in spec.devices if not stops_robot(d, robot.name)
                   and any(d.name in r.devices for r in records[: unsafe_row + 1])]
@@ -150,9 +150,10 @@ def explain(layout, records, unsafe_row: int) -> Why:
         return Why.model_construct(detected=False, devices=timings, stopped_by=None, braking_from_s=None,
                                    standstill_at_s=None, contact_at_s=contact, late_by_s=None, safeguards=words)
     first = min(stops, key=lambda t: t.stop_at_s)  # (min keeps the cell's order among equal times)
-    standstill = _r(first.stop_at_s + float(stopping_time))
+    standstill = _r(first.stop_at_s + float(stop.to_standstill))
     return Why.model_construct(detected=True, devices=timings, stopped_by=first.device,
-                               braking_from_s=first.stop_at_s, standstill_at_s=standstill, contact_at_s=contact,
+                               braking_from_s=_r(first.stop_at_s + float(stop.delay)), standstill_at_s=standstill,
+                               contact_at_s=contact,
                                late_by_s=_r(standstill - contact), safeguards=words)
 
 
@@ -174,6 +175,8 @@ def why_words(why: Why) -> str:
                "the robot stood still in time, then restarted" if restarted else
                "the robot stood still in time but the criterion still judged the contact unsafe")
     extra = "" if why.safeguards is None else f"; {why.safeguards}"
+    brake = "" if why.braking_from_s is None or why.braking_from_s == first.stop_at_s else \
+        f" (the robot's controller began to brake at {why.braking_from_s:.2f} s)"
     return (f"{first.device} saw the worker at {first.saw_at_s:.2f} s; its stop took effect at "
-            f"{first.stop_at_s:.2f} s; the robot would stand still at {why.standstill_at_s:.2f} s; the contact "
-            f"came at {why.contact_at_s:.2f} s: {verdict}{extra}")
+            f"{first.stop_at_s:.2f} s{brake}; the robot would stand still at {why.standstill_at_s:.2f} s; the "
+            f"contact came at {why.contact_at_s:.2f} s: {verdict}{extra}")

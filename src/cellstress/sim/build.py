@@ -9,6 +9,7 @@ import numpy as np
 
 from cellstress.cell.load import Cell
 from cellstress.cell.program import held_joints, robot_program
+from cellstress.cell.robot_stop import robot_stop
 from cellstress.cell.schema import ObstacleSpec, RobotSpec
 from cellstress.core import registry
 from cellstress.core.errors import CellError
@@ -21,6 +22,7 @@ from cellstress.human.reach import ReachField, reach_field
 from cellstress.robot.capsules import Capsule, base_footprint, declared_capsule, fitted_capsules
 from cellstress.robot.joints import JointMap
 from cellstress.robot.model import PRISMATIC, RobotModel, base_matrix, load_robot, resolve_urdf
+from cellstress.robot.stopping import RobotStop, hold_radii
 from cellstress.robot.trajectory import Trajectory
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
@@ -84,8 +86,9 @@ def device_arrays(devices) -> DeviceArrays:
                         np.asarray(muted, dtype=float).reshape(-1, 2), np.asarray(sep, dtype=float).reshape(-1, 6))
 
 
-def _check_separation(cell: Cell, dev: DeviceArrays) -> None:
-    """The kernel keeps one separation channel's commands, at most SEP_QUEUE - 1 time steps in flight."""
+def _check_separation(cell: Cell, dev: DeviceArrays, delay_of_robot0: float = 0.0) -> None:
+    """The kernel keeps one separation channel's commands, at most SEP_QUEUE - 1 time steps in flight (the
+    response time and the robot's controller delay)."""
     spec, rows = cell.spec, dev.separation
     if rows.shape[0] == 0:
         return
@@ -94,8 +97,10 @@ def _check_separation(cell: Cell, dev: DeviceArrays) -> None:
         raise CellError(cell.source, f"devices[{i}]", "a cell takes one speed-separation device (not implemented "
                                                       "for several)")
     limit = (L.SEP_QUEUE - 1) * spec.simulation.dt
-    if dev.response[int(rows[0, 5])] > limit + 1e-12:
-        raise CellError(cell.source, f"devices[{i}].response_time", f"must be at most {limit:g} s "
+    delay = delay_of_robot0
+    if dev.response[int(rows[0, 5])] + delay > limit + 1e-12:
+        extra = f" less the robot's controller delay {delay:g} s" if delay > 0.0 else ""
+        raise CellError(cell.source, f"devices[{i}].response_time", f"must be at most {limit:g} s{extra} "
                                                                     f"({L.SEP_QUEUE - 1} time steps of "
                                                                     f"{spec.simulation.dt:g} s)")
 
@@ -192,9 +197,10 @@ class RobotPart:
     trajectory: Trajectory
     joints: JointMap
     first_capsule: int  # its capsules' first index in Layout.capsules (and the kernel's capsule arrays)
+    stop: RobotStop  # how it stops (category, delay, braking; robot.stopping)
 
 
-def _robot_part(cell: Cell, rs: RobotSpec, first: int, prefix: str) -> RobotPart:
+def _robot_part(cell: Cell, rs: RobotSpec, first: int, prefix: str, where: str = "robot") -> RobotPart:
     robot = load_robot(resolve_urdf(rs.urdf, cell.files_dir))
     if rs.capsules == "auto":
         caps = list(fitted_capsules(robot))
@@ -205,7 +211,13 @@ def _robot_part(cell: Cell, rs: RobotSpec, first: int, prefix: str) -> RobotPart
     if prefix:
         caps = [dataclasses.replace(c, name=prefix + c.name) for c in caps]
     traj = robot_program(cell.source, robot, rs, cell.files_dir)
-    return RobotPart(rs.name, rs, robot, tuple(caps), traj, held_joints(cell.source, robot, rs), first)
+    stop = robot_stop(cell.source, where, rs, robot, traj, cell.files_dir)
+    if stop.hold:  # category 0: each capsule grown to hold the arm wherever its joints' brakes stop it
+        grow = hold_radii(robot, np.asarray([c.joint for c in caps], dtype=np.int64),
+                          np.asarray([c.p0 for c in caps], dtype=float).reshape(-1, 3),
+                          np.asarray([c.p1 for c in caps], dtype=float).reshape(-1, 3), np.asarray(stop.travel))
+        caps = [dataclasses.replace(c, radius=c.radius + float(g)) for c, g in zip(caps, grow, strict=True)]
+    return RobotPart(rs.name, rs, robot, tuple(caps), traj, held_joints(cell.source, robot, rs), first, stop)
 
 
 def _ancestors(robot: RobotModel) -> np.ndarray:
@@ -223,9 +235,10 @@ def build_layout(cell: Cell) -> Layout:
     spec = cell.spec
     parts: list[RobotPart] = []
     several = len(spec.robots) > 1
-    for rs in spec.robots:
+    for i, rs in enumerate(spec.robots):
         first = sum(len(p.capsules) for p in parts)
-        parts.append(_robot_part(cell, rs, first, f"{rs.name}:" if several else ""))
+        parts.append(_robot_part(cell, rs, first, f"{rs.name}:" if several else "",
+                                 f"robots[{i}]" if "robots" in spec.model_fields_set else "robot"))
     part0 = parts[0]
     robot, traj, task = part0.model, part0.trajectory, spec.robot.task
     caps = [c for p in parts for c in p.capsules]
@@ -243,7 +256,7 @@ def build_layout(cell: Cell) -> Layout:
     obs_verts, obs_poly, obs_box = obstacle_arrays(obstacles)
 
     dev = device_arrays(spec.devices)
-    _check_separation(cell, dev)
+    _check_separation(cell, dev, part0.stop.delay)
     doors = [d for d in range(len(dev.kind)) if dev.kind[d] == DOOR]
     if len(doors) > MAX_DOORS:  # (the cell schema refuses such a cell first)
         raise ValueError(f"{len(doors)} guard doors; the simulator takes at most {MAX_DOORS}")
@@ -258,7 +271,7 @@ def build_layout(cell: Cell) -> Layout:
 
     scal = np.zeros(L.N_SCAL)
     scal[L.C_DT] = spec.simulation.dt
-    scal[L.C_STOP_TIME] = spec.robot.stopping_time
+    _stop_scalars(scal, part0.stop)
     scal[L.C_PHASE0] = task.phase
     scal[L.C_CYCLE] = traj.cycle
     scal[L.C_LINEAR] = 1.0 if traj.linear else 0.0
@@ -325,6 +338,13 @@ def build_layout(cell: Cell) -> Layout:
                   tuple(parts), worker)
 
 
+def _stop_scalars(scal: np.ndarray, stop: RobotStop) -> None:
+    """A robot's stop in its scalars: the delay before braking, the braking time, category 0's hold."""
+    scal[L.C_STOP_TIME] = stop.braking
+    scal[L.C_STOP_DELAY] = stop.delay
+    scal[L.C_STOP_HOLD] = 1.0 if stop.hold else 0.0
+
+
 def _joint_kinds(robot: RobotModel) -> np.ndarray:
     return np.asarray([L.JOINT_PRISMATIC if k == PRISMATIC else L.JOINT_REVOLUTE for k in robot.kinds], dtype=np.int64)
 
@@ -362,7 +382,7 @@ def _other_robot_arrays(spec, parts: list[RobotPart], scal: np.ndarray) -> dict[
     for r, (rs, p) in enumerate(zip(spec.robots[1:], others, strict=True)):
         m, tr, nj, nw, nc = p.model, p.trajectory, p.model.n_joints, len(p.trajectory.starts), len(p.capsules)
         out["x_scal"][r] = scal
-        out["x_scal"][r, L.C_STOP_TIME] = rs.stopping_time
+        _stop_scalars(out["x_scal"][r], p.stop)
         out["x_scal"][r, L.C_PHASE0] = rs.task.phase
         out["x_scal"][r, L.C_CYCLE] = tr.cycle
         out["x_scal"][r, L.C_LINEAR] = 1.0 if tr.linear else 0.0

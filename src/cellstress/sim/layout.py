@@ -226,7 +226,8 @@ PHASE_RUNNING, PHASE_PENDING, PHASE_BRAKING, PHASE_STOPPED, PHASE_REDUCED = PHAS
 
 SCALARS = VectorSpec("scalar parameters (SimParams.scal)", (
     ("DT", "time step [s]"),
-    ("STOP_TIME", "robot's stopping time: from full speed to standstill [s]"),
+    ("STOP_TIME", "robot's braking time: from full speed, once it begins to brake (STOP_DELAY after its stop's "
+                  "signal), to standstill [s]"),
     ("PHASE0", "robot's path time when an episode starts [s]"),
     ("CYCLE", "robot's cycle time [s]"),
     ("LINEAR", "1: the robot's moves are at constant speed (a trajectory file); 0: minimum-jerk"),
@@ -237,10 +238,17 @@ SCALARS = VectorSpec("scalar parameters (SimParams.scal)", (
     ("ANY_MOTION", "1: the kernel test's speed condition is that the robot owning the nearest capsule is not at a "
                    "standstill (stop phase other than STOPPED), whatever v_R (verify's arrival-window model: the "
                    "robot's speed at arrival moments between grid points is not known there); 0: v_R above VTOL"),
+    # how the robot stops (issue 28; appended, so the slots above never move)
+    ("STOP_DELAY", "time from a stop's signal (detection plus the device's response) until the robot begins to brake "
+                   "[s]: the controller's delay; the latched stop (TSTOP) takes effect after it. 0 for category 0"),
+    ("STOP_HOLD", "1: a category 0 stop: from the moment it takes effect the robot is posed where it was, its "
+                  "capsules grown for the joints' independent braking (sim.build) and its speed falling to 0 "
+                  "within STOP_TIME; 0: it brakes along its path"),
 ))
 (C_DT, C_STOP_TIME, C_PHASE0, C_CYCLE, C_LINEAR, C_DTOL, C_VTOL, C_REACH_ORIGIN, C_REACH_H,
- C_ANY_MOTION) = SCALARS.indices(
-    "DT", "STOP_TIME", "PHASE0", "CYCLE", "LINEAR", "DTOL", "VTOL", "REACH_ORIGIN", "REACH_H", "ANY_MOTION")
+ C_ANY_MOTION, C_STOP_DELAY, C_STOP_HOLD) = SCALARS.indices(
+    "DT", "STOP_TIME", "PHASE0", "CYCLE", "LINEAR", "DTOL", "VTOL", "REACH_ORIGIN", "REACH_H", "ANY_MOTION",
+    "STOP_DELAY", "STOP_HOLD")
 N_SCAL = SCALARS.size
 
 DEVICE_KINDS = VectorSpec("detection primitive kinds (SimParams.dev_kind)", (

@@ -80,10 +80,10 @@ def lookahead_gaps(P, W, rows, t_stop, horizon, speed, n_tau, out):
 
 
 def default_horizon(params) -> float:
-    """T of ISO 13855 for the fastest device: its response time plus the robot's stopping time [s], the
-    shortest time for which the robot moves on after a worker is first seen."""
+    """T of ISO 13855 for the fastest device: its response time plus the robot's controller delay and braking
+    time [s], the shortest time for which the robot moves on after a worker is first seen."""
     resp = float(np.min(params.dev_resp)) if params.dev_resp.size else 0.0
-    return resp + float(params.scal[L.C_STOP_TIME])
+    return resp + float(params.scal[L.C_STOP_DELAY]) + float(params.scal[L.C_STOP_TIME])
 
 
 class Lookahead:

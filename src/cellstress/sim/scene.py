@@ -97,12 +97,15 @@ def joint_state(layout: Layout, row: np.ndarray) -> tuple[np.ndarray, np.ndarray
     """The robot's joint positions and velocities (q, q_dot) at a metric row, from the kernel's own trajectory.
 
     The row holds the path time tau and the stop phase; while braking, the time since the stop took effect
-    follows from tau = tau0 + t_s + d - d^2 / (2 T) with t = t_s + d, so the time-scaling sigma = 1 - d / T."""
+    follows from tau = tau0 + t_s + d - d^2 / (2 T) with t = t_s + d, so the time-scaling sigma = 1 - d / T (a
+    category 0 stop holds tau = tau0 + t_s, so d = t - (tau - tau0))."""
     P = layout.params
     T = float(P.scal[L.C_STOP_TIME])
     tau, t, phase = float(row[L.M_TAU]), float(row[L.M_T]), int(row[L.M_PHASE])
     if phase == L.PHASE_STOPPED:
         sigma = 0.0
+    elif phase == L.PHASE_BRAKING and P.scal[L.C_STOP_HOLD] != 0.0:
+        sigma = max(0.0, 1.0 - (t - (tau - float(P.scal[L.C_PHASE0]))) / T)
     elif phase == L.PHASE_BRAKING:
         d = float(np.sqrt(max(0.0, 2.0 * T * (t + float(P.scal[L.C_PHASE0]) - tau))))
         sigma = max(0.0, 1.0 - d / T)

@@ -11,7 +11,7 @@ from pydantic import Field
 
 from cellstress.core.fields import Record
 from cellstress.core.io import canonical_json, json_ready, write_in_folder
-from cellstress.searchers.result import CellRef, HazardClass
+from cellstress.searchers.result import CellRef, HazardClass, Severity
 from cellstress.sim.records import Name
 
 FORMAT = 2  # 2: what the verdict covers (scope), arrival windows and their alarms; no merge tolerances
@@ -113,6 +113,7 @@ class Witness(Record):
     time_s: float
     sequences: Count  # hazardous sequences of this class, over every sub-tree
     file: str  # the witness's result.json, relative to verify.json
+    severity: Severity | None = None  # its contact's (searchers.severity): the classes are listed worst first
 
 
 class VerifyResult(Record):

@@ -23,6 +23,7 @@ from cellstress.core.version import __version__
 from cellstress.human.actions import N_ACTIONS
 from cellstress.searchers.distinct import hazard_class, hazard_class_record, root_cause
 from cellstress.searchers.result import CellRef
+from cellstress.searchers.severity import worst_first
 from cellstress.sim.layout import M_STEP, M_T
 from cellstress.sim.simulator import Simulator
 from cellstress.verifier.arrival import ArrivalCover, arrival_cover, confirm_phases, inflated
@@ -41,7 +42,7 @@ from cellstress.verifier.records import (
 )
 from cellstress.verifier.scope import build_scope
 from cellstress.verifier.tree import TreeOutcome, decide
-from cellstress.verifier.witness import witness_actions, write_witness
+from cellstress.verifier.witness import witness_actions, witness_severity, write_witness
 
 WITNESS_DIR = "witness-{:02d}"
 
@@ -228,31 +229,33 @@ def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out:
 
 def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided: list[Decided],
              out: str | Path | None) -> VerifyResult:
-    """The result of the decided sub-trees: hazard classes numbered in the order first found, their witnesses
-    written (if ``out``)."""
+    """The result of the decided sub-trees: hazard classes numbered worst first (``searchers.severity``; ties in
+    the order first found), their witnesses written (if ``out``)."""
     cell = sim.cell
     classes: dict[tuple, dict[str, Any]] = {}
-    subtrees = []
     for task, d in zip(tasks, decided, strict=True):
-        counts = []
         for f in d.found:
             c = classes.get(f.key)
             if c is None:
-                c = classes[f.key] = {"index": len(classes), "task": task, "found": f, "sequences": 0}
+                c = classes[f.key] = {"task": task, "found": f, "sequences": 0}
+                c["actions"] = witness_actions(cell, task.start, f.phase, f.actions)
+                c["severity"] = witness_severity(sim, c["actions"])
             c["sequences"] += f.sequences
-            counts.append(ClassCount(klass=c["index"], sequences=f.sequences))
-        subtrees.append(d.subtree.model_copy(update={"classes": tuple(counts)}))
+    for i, c in enumerate(worst_first(list(classes.values()), key=lambda c: c["severity"])):
+        c["index"] = i
+    subtrees = [d.subtree.model_copy(update={"classes": tuple(
+        ClassCount(klass=classes[f.key]["index"], sequences=f.sequences) for f in d.found)}) for d in decided]
     witnesses = []
-    for c in classes.values():
-        task, f = c["task"], c["found"]
+    for c in sorted(classes.values(), key=lambda c: c["index"]):
+        task, f, actions = c["task"], c["found"], c["actions"]
         rel = f"{WITNESS_DIR.format(c['index'] + 1)}/result.json"
-        actions = witness_actions(cell, task.start, f.phase, f.actions)
         if out is not None:
             write_witness(sim, actions, Path(out), WITNESS_DIR.format(c["index"] + 1))
         klass = hazard_class_record(f.key)
         witnesses.append(Witness.model_construct(
             klass=klass, root_cause=root_cause(klass), start=task.start.name, phase=f.phase,
-            actions=actions, step=f.step, time_s=f.time_s, sequences=c["sequences"], file=rel))
+            actions=actions, step=f.step, time_s=f.time_s, sequences=c["sequences"], file=rel,
+            severity=c["severity"]))
     hazardous = sum(s.hazardous for s in subtrees)
     undecided = sum(s.undecided for s in subtrees)
     alarms = sum(s.alarms for s in subtrees)

@@ -16,7 +16,9 @@ from cellstress.cell.load import Cell
 from cellstress.core.version import __version__
 from cellstress.human.actions import ACTION_NAMES
 from cellstress.searchers import hazard_record
-from cellstress.searchers.result import FORMAT, CellRef, EpisodeRef, SearchResult, TopEpisode
+from cellstress.searchers.result import FORMAT, CellRef, EpisodeRef, SearchResult, Severity, TopEpisode
+from cellstress.searchers.severity import severity
+from cellstress.sim.layout import M_V
 from cellstress.sim.starts import START_PREFIX, phase_token, split_start
 from cellstress.verifier.phases import StartPoint
 
@@ -51,6 +53,14 @@ def witness_result(sim, actions: list[str], source: str) -> SearchResult:
         hazards=(EpisodeRef.model_construct(episode=1, actions=acts),),
         top=(TopEpisode.model_construct(episode=1, actions=acts, ret=ret, risk=risk, unsafe=True),),
         risk_per_episode=(risk,), distinct_sequences=1, version=__version__, format=FORMAT, distinct=None)
+
+
+def witness_severity(sim, actions: tuple[str, ...]) -> Severity:
+    """How bad a witness's contact is (``searchers.severity``), from its sequence played in ``sim``'s cell."""
+    trace = sim.run(list(actions))
+    row = trace.rows[trace.unsafe_row]
+    verdict = sim.verdict(row)
+    return severity(float(row[M_V]), None if verdict is None else verdict.as_dict())
 
 
 def write_witness(sim, actions: tuple[str, ...], out: Path, folder: str) -> Path:

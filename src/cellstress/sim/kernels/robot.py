@@ -2,8 +2,10 @@
 time and stop.
 
 The robot is a pure function of time and of the moment its stop takes effect: its path time advances one
-second per second until the stop, then slows linearly to a standstill within the stopping time, so
-tau(t) = t_s + d - d^2 / (2 T) for d = t - t_s < T. Nothing is integrated, so nothing drifts.
+second per second until the stop, then slows linearly to a standstill within the braking time, so
+tau(t) = t_s + d - d^2 / (2 T) for d = t - t_s < T. Nothing is integrated, so nothing drifts. The stop takes
+effect when braking begins: a controller's delay is added to the moment it is latched (``step.sense_stop``),
+and a category 0 stop holds the pose where it took effect (``path_time``; docs/robot.md, Stopping).
 
 With the safeguards of issue 18 (a stop released by an automatic restart, a warning field's speed reduction) the
 time scaling sigma = dtau/dt is piecewise linear: from an anchor (a release's time, path time and sigma, kept in
@@ -24,6 +26,7 @@ from cellstress.sim.layout import (
     C_DT,
     C_LINEAR,
     C_PHASE0,
+    C_STOP_HOLD,
     C_STOP_TIME,
     JOINT_PRISMATIC,
     NS,
@@ -47,7 +50,9 @@ from cellstress.sim.layout import (
 
 @njit(cache=True, error_model="numpy", inline="always")
 def path_time(scal, t, t_stop):
-    """(path time tau, time-scaling sigma = dtau/dt, stop phase) at time t for a stop effective at t_stop."""
+    """(path time tau, time-scaling sigma = dtau/dt, stop phase) at time t for a stop effective at t_stop (the
+    moment braking begins: the controller's delay is in t_stop). A category 0 stop (STOP_HOLD) holds the path
+    time where it took effect, sigma still falling to 0 within T, so v_R is the speed there scaled down."""
     T = scal[C_STOP_TIME]
     tau0 = scal[C_PHASE0]
     if not t_stop < np.inf:
@@ -55,6 +60,10 @@ def path_time(scal, t, t_stop):
     if t < t_stop:
         return tau0 + t, 1.0, PHASE_PENDING
     d = t - t_stop
+    if scal[C_STOP_HOLD] != 0.0:  # category 0: posed where the stop took effect (docs/robot.md, Stopping)
+        if d >= T:
+            return tau0 + t_stop, 0.0, PHASE_STOPPED
+        return tau0 + t_stop, 1.0 - d / T, PHASE_BRAKING
     if d >= T:
         return tau0 + t_stop + 0.5 * T, 0.0, PHASE_STOPPED
     return tau0 + t_stop + d - d * d / (2.0 * T), 1.0 - d / T, PHASE_BRAKING

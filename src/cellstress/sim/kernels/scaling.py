@@ -4,9 +4,9 @@ A channel whose ``dev_speed`` is ``layout.SEPARATION`` (its rule a row of ``dev_
 step the horizontal separation between the worker it sees and robot 0, and commands the speed fraction its
 rule allows (full speed where it does not see the worker). Each step's command is queued in the state
 (``SEP_Q*``, by step modulo ``SEP_QUEUE``) and takes effect at its measuring time plus the channel's response
-time: the path is re-anchored there, in closed form, towards the commanded fraction, and its time scaling
-ramps to it at the robot's own braking rate (``robot.live_path_time``). The robot stays a pure function of the
-state and the time; a cell without such a channel never enters here.
+time and the robot's controller delay: the path is re-anchored there, in closed form, towards the commanded
+fraction, and its time scaling ramps to it at the robot's own braking rate (``robot.live_path_time``). The robot
+stays a pure function of the state and the time; a cell without such a channel never enters here.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from cellstress.sim.layout import (
     B_BODY_RADIUS,
     C_DT,
     C_PHASE0,
+    C_STOP_DELAY,
     S_A_SIG,
     S_A_T,
     S_A_TAU,
@@ -47,7 +48,7 @@ def commands_due(P, state, k):
     if P.dev_sep.shape[0] == 0:
         return
     dt = P.scal[C_DT]
-    resp = P.dev_resp[int(P.dev_sep[0, 5])]
+    resp = P.dev_resp[int(P.dev_sep[0, 5])] + P.scal[C_STOP_DELAY]  # a command acts after the controller's delay
     t_prev, t = (k - 1) * dt, k * dt
     for j in range(max(0, k - SEP_QUEUE + 1), k):
         t_c = j * dt + resp

@@ -43,6 +43,7 @@ from cellstress.sim.layout import (
     C_PHASE0,
     C_REACH_H,
     C_REACH_ORIGIN,
+    C_STOP_DELAY,
     C_VTOL,
     DEV_DOOR,
     M_ACTION,
@@ -180,15 +181,18 @@ def sense_and_measure(P, state, W, row, action):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def sense_stop(P, state, d, t):
-    """Device d sees the worker at t: a stop is latched, taking effect after its response time (an earlier one
-    replaces a later one), for each robot the device stops (robot 0 below; robots 1.. their own TSTOP)."""
-    t_s = t + P.dev_resp[d]
+    """Device d sees the worker at t: a stop is latched, taking effect after its response time and the robot's
+    controller delay (when braking begins; an earlier one replaces a later one), for each robot the device stops
+    (robot 0 below; robots 1.. their own TSTOP and delay)."""
+    t_sig = t + P.dev_resp[d]
     mask = P.dev_robots[d]
     for r in range(P.x_scal.shape[0]):
-        if mask >> (r + 1) & 1 and t_s < state[S_XTSTOP + r]:
-            state[S_XTSTOP + r] = t_s
+        t_r = t_sig + P.x_scal[r, C_STOP_DELAY]
+        if mask >> (r + 1) & 1 and t_r < state[S_XTSTOP + r]:
+            state[S_XTSTOP + r] = t_r
     if not mask & 1:
         return
+    t_s = t_sig + P.scal[C_STOP_DELAY]
     # the clear time a latched stop waits for: its first device's, then the longest of those that see
     state[S_STOP_CLEAR] = P.dev_clear[d] if state[S_TSTOP] == np.inf else max(state[S_STOP_CLEAR], P.dev_clear[d])
     if t_s < state[S_TSTOP]:
@@ -219,8 +223,9 @@ def latch_seen(P, state, seen, t):
 @njit(cache=True, error_model="numpy", inline="always")
 def sense_warning(P, state, d, t):
     """Warning field d sees the worker at t: its speed reduction is latched (the first one's fraction holds
-    until it is released), taking effect after the response time; the robot leaves the plain path model."""
-    t_w = t + P.dev_resp[d]
+    until it is released), taking effect after the response time and the controller's delay; the robot leaves the
+    plain path model."""
+    t_w = t + P.dev_resp[d] + P.scal[C_STOP_DELAY]
     if state[S_TSLOW] == np.inf:
         state[S_SLOW] = P.dev_speed[d]
         state[S_SLOW_CLEAR] = P.dev_clear[d]
