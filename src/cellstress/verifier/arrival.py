@@ -30,7 +30,7 @@ that is hazardous there is a real hazard, with its exact arrival moment as the w
 unconfirmed alarm, reported as such, and the verdict is not a proof.
 
 **Sampling slack.** The displacement is measured on samples ``SAMPLE`` s apart, for lags that are multiples of it;
-between samples and lags a point moves at most its capsule's speed bound (``reach.capsule_speeds``) times the
+between samples and lags a point moves at most its capsule's speed bound (``sim.speeds.capsule_speeds``) times the
 distance to the nearest sample at each end, so ``2 * speed * SAMPLE`` is added.
 """
 
@@ -44,7 +44,7 @@ import numpy as np
 from cellstress.sim import layout as L
 from cellstress.sim.build import Layout
 from cellstress.sim.scene import robot_capsules
-from cellstress.verifier.reach import capsule_speeds
+from cellstress.sim.speeds import capsule_speeds
 
 SAMPLE = 1e-3  # s of path time between the samples the displacement is measured on
 REACH_LIPSCHITZ = 3.0 ** 0.5  # the reach field's largest slope: a trilinear interpolant of a 1-Lipschitz grid
