@@ -32,7 +32,7 @@ import numpy as np
 from cellstress.core.jit import njit
 from cellstress.sim.geometry import NO_REFCOUNT, segment_segment_xyz
 from cellstress.sim.kernels.body import pose_body
-from cellstress.sim.kernels.fences import collect_near_fences
+from cellstress.sim.kernels.fences import blocking_panel, collect_near_fences, fence_detour_bound
 from cellstress.sim.kernels.params import SWEEP_CERTIFIED, SWEEP_DEPTH
 from cellstress.sim.kernels.reach import TRACE_REL_TOL, reach_field_at
 from cellstress.sim.kernels.robot import _robot_live, live_path_time, path_time
@@ -205,11 +205,15 @@ def _certified(P, W):
     """A lower bound on the distance between the robot and the worker as posed in W (by ``_sample``): body
     capsules exactly; each reach volume by its field sampled along each robot capsule's axis at most
     ``CERT_STEP`` apart, less the field's slope times half that spacing (every axis point lies within it of a
-    sample), less the radius. (Fences only lengthen a reach, so the field alone bounds it from below.)"""
+    sample), less the radius. Fences only lengthen a reach: where a near panel holds the hand back, the fence
+    detour's lower bound (1-Lipschitz along an axis that crosses no panel) less half the spacing bounds it too, and
+    the larger of the two holds (without it, a reach held back by a panel near the robot could never be cleared)."""
     ra, rb, cap_r, ha, hb, hr = W.ra, W.rb, P.cap_r, W.ha, W.hb, W.hr
     n_caps = int(P.body[B_N_CAPS])
-    arm = P.body[B_ARM_LEN] + 2.0 * P.scal[C_REACH_H]  # every reach volume lies within this of its shoulder
+    arm_len = P.body[B_ARM_LEN]
+    arm = arm_len + 2.0 * P.scal[C_REACH_H]  # every reach volume lies within this of its shoulder
     origin, grid_h = P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H]
+    n_near = collect_near_fences(W.fences, W.sh, W.near, arm_len + 0.05)  # as separation gathers them
     best = np.inf
     for c in range(cap_r.shape[0]):
         r = cap_r[c]
@@ -223,7 +227,10 @@ def _certified(P, W):
             continue  # (the articulated worker has no reach volumes)
         length = np.sqrt((rb[c, 0] - ra[c, 0]) ** 2 + (rb[c, 1] - ra[c, 1]) ** 2 + (rb[c, 2] - ra[c, 2]) ** 2)
         n = max(1, int(np.ceil(length / CERT_STEP)))
-        slack = 0.5 * REACH_SLOPE * length / n
+        half = 0.5 * length / n  # every axis point lies within this of a sample
+        slack = REACH_SLOPE * half
+        through = n_near > 0 and blocking_panel(W.fences, W.near, np.int64(n_near), ra[c, 0], ra[c, 1], ra[c, 2],
+                                                rb[c, 0], rb[c, 1], rb[c, 2]) >= 0
         for side in range(2):
             sx, sy, sz = W.sh[side, 0], W.sh[side, 1], W.sh[side, 2]
             # the whole axis beyond the arm's ball around the shoulder, less the radius, cannot undercut the best
@@ -233,9 +240,14 @@ def _certified(P, W):
                 continue
             for i in range(n + 1):
                 u = i / n
-                f = reach_field_at(P.reach, origin, grid_h, W.sh, W.tr, side, ra[c, 0] + u * (rb[c, 0] - ra[c, 0]),
-                                   ra[c, 1] + u * (rb[c, 1] - ra[c, 1]), ra[c, 2] + u * (rb[c, 2] - ra[c, 2]))
-                d = f - slack - r
+                px, py, pz = ra[c, 0] + u * (rb[c, 0] - ra[c, 0]), ra[c, 1] + u * (rb[c, 1] - ra[c, 1]), \
+                    ra[c, 2] + u * (rb[c, 2] - ra[c, 2])
+                d = reach_field_at(P.reach, origin, grid_h, W.sh, W.tr, side, px, py, pz) - slack - r
+                if n_near > 0 and not through and d < best:
+                    g_lb = fence_detour_bound(W.fences, W.near, np.int64(n_near), sx, sy, sz, px, py, pz,
+                                              np.inf)[1] - arm_len - half - r
+                    if g_lb > d:
+                        d = g_lb
                 if d < best:
                     best = d
     return best
