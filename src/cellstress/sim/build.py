@@ -26,6 +26,7 @@ from cellstress.robot.stopping import RobotStop, hold_radii
 from cellstress.robot.trajectory import Trajectory
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
+from cellstress.sim.speeds import capsule_speeds
 
 SCANNER, CURTAIN, DOOR = L.DEV_SCANNER, L.DEV_CURTAIN, L.DEV_DOOR  # detection primitive kinds in the kernel
 
@@ -281,12 +282,15 @@ def build_layout(cell: Cell) -> Layout:
     scal[L.C_VTOL] = np.inf if fast is None else fast.speed_tolerance
     scal[L.C_REACH_ORIGIN] = reach.origin
     scal[L.C_REACH_H] = reach.spacing
+    scal[L.C_SWEEP] = 1.0  # contact in continuous time between the steps (kernels.sweep)
+    act = np.ascontiguousarray(worker.action_table(spec.human.max_forward_flexion_deg,
+                                                   spec.human.max_lateral_flexion_deg, anth.height))
+    scal[L.C_RHO] = K.worker_radius(body.params(), float(act[:, L.A_DROP].max(initial=0.0)), reach.spacing)
 
     params = K.SimParams(
         scal=scal,
         spa=int(spec.simulation.steps_per_action),
-        act=np.ascontiguousarray(worker.action_table(spec.human.max_forward_flexion_deg,
-                                                     spec.human.max_lateral_flexion_deg, anth.height)),
+        act=act,
         body=body.params(),
         base=base_matrix(spec.robot.base.xyz, spec.robot.base.yaw_deg),
         parents=robot.parents.astype(np.int64),
@@ -332,6 +336,7 @@ def build_layout(cell: Cell) -> Layout:
         pre_xv=np.zeros((0, len(parts) - 1)),
         pre_xtau=np.zeros((0, len(parts) - 1)),
         dev_sep=dev.separation,
+        cap_speed=np.concatenate([capsule_speeds(p) for p in parts]),
     )
     params = _with_robot_table(params, spec)
     return Layout(cell, robot, tuple(caps), traj, body, reach, dev.names, params, part0.joints, obstacles,

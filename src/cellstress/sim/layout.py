@@ -129,6 +129,9 @@ STATE = StateSpec.of("state vector (a snapshot is a copy of it)", (
     *((f"ARM{k}_Q{j}", f"{side} arm's joint {j} [rad] (human.reach's order: shoulder flexion, abduction, upper-arm "
                        "rotation, elbow flexion, wrist flexion), relative to the trunk", EXACT)
       for k, side in enumerate(("left", "right")) for j in range(5)),
+    # the swept contact test (issue 34; appended)
+    ("D_SEP", "d_HR at the state's time as separation computed it, before clipping at 0 [m] (the swept contact "
+              "test starts the next step from it: kernels.sweep)", EXACT),
 ))
 (S_K, S_X, S_Y, S_HEADING, S_FWD, S_LAT, S_TSTOP, S_TRIG_DEV, S_TRIG_T, S_UNSAFE, S_ACTIONS, S_LIVE, S_A_T, S_A_TAU,
  S_A_SIG, S_A_TGT, S_TSLOW, S_SLOW, S_STOP_SEEN, S_STOP_CLEAR, S_SLOW_SEEN, S_SLOW_CLEAR, S_RESTARTS,
@@ -136,11 +139,11 @@ STATE = StateSpec.of("state vector (a snapshot is a copy of it)", (
  S_DOOR3_OPEN, S_XTSTOP1, S_XTSTOP2, S_XTSTOP3, S_SEP_ON, S_SEP_Q0, S_SEP_Q1, S_SEP_Q2, S_SEP_Q3, S_SEP_Q4,
  S_SEP_Q5, S_SEP_Q6, S_SEP_Q7, S_SEP_Q8, S_SEP_Q9, S_SEP_Q10, S_SEP_Q11, S_SEP_Q12, S_SEP_Q13, S_SEP_Q14, S_SEP_Q15,
  S_SEP_LOW, S_SEP_LOW_T, S_SEP_LOW_S, S_DROP, S_ARM0_Q0, S_ARM0_Q1, S_ARM0_Q2, S_ARM0_Q3, S_ARM0_Q4, S_ARM1_Q0,
- S_ARM1_Q1, S_ARM1_Q2, S_ARM1_Q3, S_ARM1_Q4) = STATE.indices(
+ S_ARM1_Q1, S_ARM1_Q2, S_ARM1_Q3, S_ARM1_Q4, S_D_SEP) = STATE.indices(
     "K", "X", "Y", "HEADING", "FWD", "LAT", "TSTOP", "TRIG_DEV", "TRIG_T", "UNSAFE", "ACTIONS", "LIVE", "A_T", "A_TAU",
     "A_SIG", "A_TGT", "TSLOW", "SLOW", "STOP_SEEN", "STOP_CLEAR", "SLOW_SEEN", "SLOW_CLEAR", "RESTARTS",
     *_DOOR_SLOTS, "XTSTOP1", "XTSTOP2", "XTSTOP3", "SEP_ON", "SEP_Q0", *_SEP_SLOTS, "SEP_LOW",
-    "SEP_LOW_T", "SEP_LOW_S", "DROP", *_ARM_SLOTS)
+    "SEP_LOW_T", "SEP_LOW_S", "DROP", *_ARM_SLOTS, "D_SEP")
 S_ARM = S_ARM0_Q0  # arm k's joint j: S_ARM + 5 k + j
 S_DOOR_REQ, S_DOOR_OPEN = S_DOOR0_REQ, S_DOOR0_OPEN  # door i's slots: these + i (the kernels index by door)
 NS = STATE.size
@@ -181,14 +184,20 @@ ROW = VectorSpec("metric row (one per time step; row 0 of an episode is its star
     # the articulated worker (appended): the pose beyond X..LAT, as the state's DROP and ARMk_Qj
     ("DROP", "the hip's height above standing [m] (state DROP)"),
     *((f"ARM{k}_Q{j}", f"arm {k}'s joint {j} [rad] (state ARM{k}_Q{j})") for k in range(2) for j in range(5)),
+    # the swept contact test (issue 34; appended)
+    ("TC", "time of the contact the row reports [s]: T for the step's own sample, earlier for one the swept test "
+           "found between the previous step and this one; -1: no contact"),
+    ("SWEPT", "how the row's contact was found: 0 at the step's sample (or none), 1 at an in-between sample of the "
+              "swept test, 2 the swept test could not rule one out within its finest sub-step (a conservative "
+              "unsafe step: D and the points are then the nearer end's)"),
 ))
 (M_T, M_X, M_Y, M_HEADING, M_FWD, M_LAT, M_D, M_V, M_SEEN, M_PHASE, M_LINK, M_PART, M_RX, M_RY, M_RZ, M_HX, M_HY, M_HZ,
  M_UNSAFE, M_TAU, M_ACTION, M_STEP, M_ROBOT, M_XTAU1, M_XTAU2, M_XTAU3, M_XPHASE1, M_XPHASE2, M_XPHASE3, M_DROP,
  M_ARM0_Q0, M_ARM0_Q1, M_ARM0_Q2, M_ARM0_Q3, M_ARM0_Q4, M_ARM1_Q0, M_ARM1_Q1, M_ARM1_Q2, M_ARM1_Q3,
- M_ARM1_Q4) = ROW.indices(
+ M_ARM1_Q4, M_TC, M_SWEPT) = ROW.indices(
     "T", "X", "Y", "HEADING", "FWD", "LAT", "D", "V", "SEEN", "PHASE", "LINK", "PART", "RX", "RY", "RZ", "HX", "HY",
     "HZ", "UNSAFE", "TAU", "ACTION", "STEP", "ROBOT", "XTAU1", "XTAU2", "XTAU3", "XPHASE1", "XPHASE2", "XPHASE3",
-    "DROP", *_ARM_SLOTS)
+    "DROP", *_ARM_SLOTS, "TC", "SWEPT")
 M_ARM = M_ARM0_Q0
 NM = ROW.size
 # A worker's pose as a vector (Simulator.worker_paths, worker_distances, scene.body_pose): x, y, heading, forward
@@ -244,11 +253,15 @@ SCALARS = VectorSpec("scalar parameters (SimParams.scal)", (
     ("STOP_HOLD", "1: a category 0 stop: from the moment it takes effect the robot is posed where it was, its "
                   "capsules grown for the joints' independent braking (sim.build) and its speed falling to 0 "
                   "within STOP_TIME; 0: it brakes along its path"),
+    ("SWEEP", "1: contact is tested in continuous time between the steps (kernels.sweep); 0: at the steps alone "
+              "(for the cross-check against finely sampled motion)"),
+    ("RHO", "a radius about the worker's hip pivot (x, y, hip height plus the stance's drop) that holds every "
+            "point of the worker in every pose, reach volumes included (kernels.body.worker_radius) [m]"),
 ))
 (C_DT, C_STOP_TIME, C_PHASE0, C_CYCLE, C_LINEAR, C_DTOL, C_VTOL, C_REACH_ORIGIN, C_REACH_H,
- C_ANY_MOTION, C_STOP_DELAY, C_STOP_HOLD) = SCALARS.indices(
+ C_ANY_MOTION, C_STOP_DELAY, C_STOP_HOLD, C_SWEEP, C_RHO) = SCALARS.indices(
     "DT", "STOP_TIME", "PHASE0", "CYCLE", "LINEAR", "DTOL", "VTOL", "REACH_ORIGIN", "REACH_H", "ANY_MOTION",
-    "STOP_DELAY", "STOP_HOLD")
+    "STOP_DELAY", "STOP_HOLD", "SWEEP", "RHO")
 N_SCAL = SCALARS.size
 
 DEVICE_KINDS = VectorSpec("detection primitive kinds (SimParams.dev_kind)", (

@@ -95,7 +95,8 @@ class Lookahead:
 
     def __init__(self, params, horizon: float | None = None, speed: float = 1.6, step: float | None = None):
         if params.x_scal.shape[0]:  # several robots: the gap is robot 0's (its capsules only; the others unposed)
-            params = params._replace(cap_r=np.ascontiguousarray(params.cap_r[:params.cap_joint.shape[0]]))
+            params = params._replace(cap_r=np.ascontiguousarray(params.cap_r[:params.cap_joint.shape[0]]),
+                                     cap_speed=np.ascontiguousarray(params.cap_speed[:params.cap_joint.shape[0]]))
         self.params = params
         self.horizon = default_horizon(params) if horizon is None else float(horizon)
         if not self.horizon >= 0.0 or not speed >= 0.0:

@@ -30,52 +30,20 @@ from __future__ import annotations
 import numpy as np
 
 from cellstress.core.jit import njit, prange
-from cellstress.robot.model import PRISMATIC
 from cellstress.sim import layout as L
+from cellstress.sim.kernels.body import worker_radius as body_radius
+from cellstress.sim.kernels.sweep import flag_distance
 from cellstress.sim.scene import robot_capsules
+from cellstress.sim.speeds import capsule_speeds
 
 GRID = 0.05  # m: floor grid of the field
 SUB = 4  # robot samples per time step
-REACH_SLACK = 2.0  # reach-field grid spacings added to the worker's radius
-PEAK = 1.875  # a minimum-jerk segment's peak speed over its mean speed
 
 
 def worker_radius(body: np.ndarray, reach_spacing: float) -> float:
-    """A radius about the hip pivot that holds every point of the worker, in every pose (see the module)."""
-    hz, leg = body[L.B_HIP_Z], body[L.B_LEG_HALF]
-    shoulder = float(np.hypot(body[L.B_SHOULDER_RISE], body[L.B_SHOULDER_HALF]))
-    return float(max(np.hypot(hz, leg) + body[L.B_R_LEG], body[L.B_TRUNK_TOP] + body[L.B_R_TRUNK],
-                     body[L.B_HEAD_RISE] + body[L.B_R_HEAD], shoulder + body[L.B_ARM_LEN] + body[L.B_R_ARM])
-                 + REACH_SLACK * reach_spacing)
-
-
-def capsule_speeds(part) -> np.ndarray:
-    """For each capsule of one robot (a ``sim.build.RobotPart``), an upper bound on the speed of any point of its
-    axis per second of path time (see the module)."""
-    model, traj = part.model, part.trajectory
-    wp = np.asarray(traj.waypoints)
-    moves = np.asarray(traj.move_times, dtype=float)
-    qd_max = np.zeros(wp.shape[1])
-    for i in range(len(wp)):
-        step = np.abs(wp[(i + 1) % len(wp)] - wp[i])
-        qd_max = np.maximum(qd_max, PEAK * step / moves[i])
-    prismatic = np.asarray([k == PRISMATIC for k in model.kinds])
-    # a move's joint values stay between its two waypoints' (minimum-jerk and linear moves are monotone), so a
-    # prismatic joint's slide is at most its largest waypoint value, and it carries the joints below it that far
-    slide = np.where(prismatic, np.abs(wp).max(axis=0), 0.0)
-    link = np.linalg.norm(np.asarray(model.placements)[:, :3, 3], axis=1)  # from the parent's origin, unslid
-    out = np.zeros(len(part.capsules))
-    for c, cap in enumerate(part.capsules):
-        speed, lever, i = 0.0, max(np.linalg.norm(cap.p0), np.linalg.norm(cap.p1)), int(cap.joint)
-        while i >= 0:  # joint i moves the point; its distance from joint i's origin is at most ``lever``
-            if prismatic[i]:
-                speed += qd_max[i]  # a slide moves every point it carries at its own speed
-            else:
-                speed += qd_max[i] * lever  # a turn: at most the point's distance from the axis times the rate
-            lever += link[i] + slide[i]
-            i = int(model.parents[i])
-        out[c] = speed  # (0 for a capsule on the base: joint -1)
-    return out
+    """A radius about the hip pivot that holds every point of the paper's worker, in every pose (see the module:
+    ``kernels.body.worker_radius``, the one the swept contact test uses too)."""
+    return float(body_radius(body, 0.0, reach_spacing))
 
 
 def robot_point_speed(layout) -> float:
@@ -90,7 +58,9 @@ class SweptField:
         P = sim.params
         self.dt = float(P.scal[L.C_DT])
         self.spa = P.spa
-        self.dtol = float(P.scal[L.C_DTOL])
+        # a step may count as unsafe up to this d_HR: the contact distance, or where the swept test between the
+        # steps cannot rule a contact out (kernels.sweep.flag_distance)
+        self.dtol = flag_distance(P) if P.scal[L.C_SWEEP] != 0.0 else float(P.scal[L.C_DTOL])
         self.stride = float(P.body[L.B_WALK_SPEED]) * self.dt
         self.radius = worker_radius(P.body, float(P.scal[L.C_REACH_H]))
         self.hip = float(P.body[L.B_HIP_Z])

@@ -5,8 +5,24 @@ and verify.json all show this record, so no message claims more than the run dec
 from __future__ import annotations
 
 from cellstress.sim import layout as L
+from cellstress.sim.kernels.sweep import flag_distance
 from cellstress.verifier.arrival import ArrivalCover
 from cellstress.verifier.records import Approximation, Scope, VerifyOptions
+
+
+def _between_steps(sim, dt: float) -> Approximation:
+    """How contact between the time steps is tested (``kernels.sweep``)."""
+    P = sim.params
+    if P.scal[L.C_SWEEP] == 0.0:
+        return Approximation(name="time step", size=dt, unit="s",
+                             what="contact is tested at every time step only; a contact that begins and ends "
+                                  "between two steps is not seen")
+    margin = flag_distance(P) - float(P.scal[L.C_DTOL])
+    return Approximation(name="between steps", size=margin, unit="m",
+                         what=f"contact is tested in continuous time between the {dt:g} s steps (the worker on the "
+                              "straight line between its sampled poses, the robot on its path); where it cannot be "
+                              "ruled out within 1/32 of a step it counts, so a pass this much closer than the "
+                              "contact distance may count as a contact (never a miss)")
 
 
 def arrival_text(options: VerifyOptions, cover: ArrivalCover, grid: bool, phases: tuple[float, ...],
@@ -36,9 +52,7 @@ def build_scope(sim, options: VerifyOptions, cover: ArrivalCover, grid: bool, st
     cycle = float(sim.layout.trajectory.cycle)
     arrival, between = arrival_text(options, cover, grid, phases, cycle, dt)
     approx = [
-        Approximation(name="time step", size=dt, unit="s",
-                      what="contact is tested at every time step; a contact that begins and ends between two "
-                           "steps is not seen"),
+        _between_steps(sim, dt),
         Approximation(name="merging", size=0.0, unit="m",
                       what="none: states merge only when every slot that decides the future is equal bit for bit"),
         Approximation(name="reach field", size=float(sim.params.scal[L.C_REACH_H]), unit="m",

@@ -18,7 +18,7 @@ the layout constants are not among them: they are read from ``sim.layout``.
 """
 
 from cellstress.sim.kernels.batch import make_handle, run_batch, run_episode, step_with_handle
-from cellstress.sim.kernels.body import human_pose, pose_body, pose_capsules
+from cellstress.sim.kernels.body import human_pose, pose_body, pose_capsules, worker_radius
 from cellstress.sim.kernels.fences import collect_near_fences, fence_detour, near_fences
 from cellstress.sim.kernels.params import SimParams, Work, make_work
 from cellstress.sim.kernels.reach import TRACE_REL_TOL, reach_value
@@ -46,7 +46,7 @@ __all__ = [
     "SimParams", "Work", "make_work",
     "robot_live", "joint_trajectory", "forward_kinematics", "fastest_joint_speed", "robot_capsules", "robot_table",
     "other_robots",
-    "human_pose", "pose_body", "pose_capsules",
+    "human_pose", "pose_body", "pose_capsules", "worker_radius",
     "near_fences", "collect_near_fences", "fence_detour",
     "reach_value", "TRACE_REL_TOL",
     "device_sees", "trunk_clear",

@@ -28,6 +28,23 @@ from cellstress.sim.layout import (
     POSE_EXT,
 )
 
+REACH_SLACK = 2.0  # reach-field grid spacings added to the worker's radius (the field is interpolated)
+
+
+@njit(cache=True, error_model="numpy")
+def worker_radius(b, max_drop, reach_h):
+    """A radius about the hip pivot (x, y, hip height plus the stance's drop) that holds every point of the
+    worker, in every pose (``max_drop``: the highest the stance lifts the hip, 0 for the paper's worker): the
+    legs hang from the pivot to the floor, the trunk, head and shoulders turn rigidly about it (``pose_body``),
+    the arms hang or reach from the shoulders and the reach volumes lie within the arm's length of them (fences
+    only shorten a reach); the reach field is a grid, so ``REACH_SLACK`` spacings are added for its
+    interpolation."""
+    hz, leg = b[B_HIP_Z] + max(max_drop, 0.0), b[B_LEG_HALF]
+    shoulder = np.sqrt(b[B_SHOULDER_RISE] ** 2 + b[B_SHOULDER_HALF] ** 2)
+    r_arm = max(b[B_R_ARM], b[B_R_UPPER], b[B_R_FORE], b[B_R_HAND])
+    return max(np.sqrt(hz * hz + leg * leg) + b[B_R_LEG], b[B_TRUNK_TOP] + b[B_R_TRUNK], b[B_HEAD_RISE] + b[B_R_HEAD],
+               shoulder + b[B_ARM_LEN] + r_arm) + REACH_SLACK * reach_h
+
 
 @njit(cache=True, error_model="numpy")
 def human_pose(P, pose, W):

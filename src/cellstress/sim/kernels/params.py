@@ -8,7 +8,11 @@ from typing import NamedTuple
 import numpy as np
 
 from cellstress.core.jit import njit
-from cellstress.sim.layout import MAX_CAPSULES
+from cellstress.sim.layout import MAX_CAPSULES, NM, NS
+
+SWEEP_DEPTH = 5  # the swept test halves a step this often on separation's values (1/32 of a step)
+SWEEP_CERTIFIED = 3  # then this often more on certified lower bounds (1/256 of a step)
+SWEEP_STACK = SWEEP_DEPTH + SWEEP_CERTIFIED + 2  # intervals waiting at most: one per level, and one being split
 
 
 class SimParams(NamedTuple):
@@ -81,6 +85,9 @@ class SimParams(NamedTuple):
     # speed and separation monitoring, one row per channel whose dev_speed is layout.SEPARATION (at most one: the
     # cell schema): v_h, v_max, configured T_r and T_s, allowance C + Z_d + Z_r, the channel's row of dev_*
     dev_sep: np.ndarray  # (n_sep, 6)
+    # the swept contact test (kernels.sweep): per capsule (every robot's), a bound on the speed of any point of
+    # its axis per second of path time (sim.speeds)
+    cap_speed: np.ndarray  # (nc,)
 
 
 class Work(NamedTuple):
@@ -115,6 +122,10 @@ class Work(NamedTuple):
     ext2: np.ndarray  # (11,) an in-between pose of the sweep (sensing.path_blocked)
     pa: np.ndarray  # (MAX_CAPSULES, 3) capsule ends at the sweep's previous in-between pose
     pb: np.ndarray
+    prev: np.ndarray  # (NS,) the state before the step being taken (the swept contact test starts from it)
+    srow: np.ndarray  # (NM,) a metric row for the swept test's in-between samples
+    crow: np.ndarray  # (NM,) the contact it found so far
+    stack: np.ndarray  # (SWEEP_STACK, 6) its intervals still to test: s_a, s_b, d_a, d_b, depth, certified
 
 
 @njit(cache=True, error_model="numpy")
@@ -132,4 +143,5 @@ def make_work(P):
         np.zeros(njx), np.zeros(njx), np.zeros((njx, 3, 3)), np.zeros((njx, 3)), np.zeros((ncx, 3)),
         np.zeros((ncx, 3)), np.zeros(nx), np.zeros(nx), np.zeros(nx), np.zeros(11), np.zeros(11), np.zeros(11),
         np.zeros((MAX_CAPSULES, 3)), np.zeros((MAX_CAPSULES, 3)),
+        np.zeros(NS), np.zeros(NM), np.zeros(NM), np.zeros((SWEEP_STACK, 6)),
     )

@@ -20,6 +20,7 @@ from cellstress.sim.kernels.robot import live_path_time, other_robots, robot_at
 from cellstress.sim.kernels.scaling import command, commands_due
 from cellstress.sim.kernels.sensing import body_blocked, device_sees, feet_ok, path_blocked
 from cellstress.sim.kernels.separation import separation
+from cellstress.sim.kernels.sweep import sweep_step
 from cellstress.sim.layout import (
     A_DIR,
     A_DROP,
@@ -44,6 +45,7 @@ from cellstress.sim.layout import (
     C_REACH_H,
     C_REACH_ORIGIN,
     C_STOP_DELAY,
+    C_SWEEP,
     C_VTOL,
     DEV_DOOR,
     M_ACTION,
@@ -56,8 +58,10 @@ from cellstress.sim.layout import (
     M_ROBOT,
     M_SEEN,
     M_STEP,
+    M_SWEPT,
     M_T,
     M_TAU,
+    M_TC,
     M_UNSAFE,
     M_V,
     M_X,
@@ -76,6 +80,7 @@ from cellstress.sim.layout import (
     S_A_TGT,
     S_ACTIONS,
     S_ARM,
+    S_D_SEP,
     S_DOOR_OPEN,
     S_DOOR_REQ,
     S_DROP,
@@ -171,6 +176,9 @@ def sense_and_measure(P, state, W, row, action):
     row[M_SEEN] = seen
     row[M_PHASE] = phase
     row[M_UNSAFE] = 1.0 if unsafe else 0.0
+    row[M_TC] = t if d_hr <= P.scal[C_DTOL] else -1.0
+    row[M_SWEPT] = 0.0
+    state[S_D_SEP] = d_hr  # where the swept test of the next step starts (not clipped: kernels.sweep)
     row[M_TAU] = tau
     row[M_ACTION] = action
     row[M_STEP] = k
@@ -297,10 +305,17 @@ def step_action(P, state, action, W, out, row0):
     h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
     begin_action(P, state, W)
     n = 0
+    sweep = P.scal[C_SWEEP] != 0.0
+    prev = W.prev
     for j in range(1, spa + 1):
+        if sweep:
+            for i in range(NS):
+                prev[i] = state[i]
         move_worker(P, state, action, h0, f0, l0, j / spa, W)
         state[S_K] += 1.0
         unsafe = sense_and_measure(P, state, W, out[row0 + n], action)
+        if sweep and not unsafe:
+            unsafe = sweep_step(P, prev, state, W, out[row0 + n])
         n += 1
         if unsafe:
             break

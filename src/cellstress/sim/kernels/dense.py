@@ -1,0 +1,54 @@
+"""The swept contact test's cross-check: episodes whose contact is tested at every step and at evenly spaced
+moments between the steps, on the same continuous motion (``kernels.sweep``: the worker on the straight line
+between its sampled poses, the robot on its path), with no bound and no halving. ``benchmarks/sweep_check.py``
+compares it with the swept test."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cellstress.core.jit import njit, prange
+from cellstress.sim.kernels.params import make_work
+from cellstress.sim.kernels.step import begin_action, move_worker, sense_and_measure
+from cellstress.sim.kernels.sweep import _sample
+from cellstress.sim.layout import C_DT, C_DTOL, NM, NS, S_FWD, S_HEADING, S_K, S_LAT
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def dense_batch(P, s0, actions, n_sub, unsafe_step):
+    """unsafe_step[e]: the first step of episode e (actions[e], played from s0 with ``P``'s swept test off) at
+    which the kernel test holds at the step's sample or at one of the ``n_sub - 1`` moments evenly between it
+    and the previous step; -1: none."""
+    n_ep, n_act = actions.shape
+    spa = P.spa
+    dt = P.scal[C_DT]
+    for e in prange(n_ep):
+        W = make_work(P)
+        state = s0.copy()
+        prev = np.empty(NS)
+        row = np.empty(NM)
+        srow = np.empty(NM)
+        unsafe_step[e] = -1
+        done = False
+        for a in range(n_act):
+            action = actions[e, a]
+            h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
+            begin_action(P, state, W)
+            for j in range(1, spa + 1):
+                for i in range(NS):
+                    prev[i] = state[i]
+                move_worker(P, state, action, h0, f0, l0, j / spa, W)
+                state[S_K] += 1.0
+                unsafe = sense_and_measure(P, state, W, row, action)
+                t0 = state[S_K] * dt - dt
+                for m in range(1, n_sub):
+                    if unsafe:
+                        break
+                    d, moving, _ = _sample(P, prev, state, W, m / n_sub, t0, srow)
+                    unsafe = d <= P.scal[C_DTOL] and moving
+                if unsafe:
+                    unsafe_step[e] = int(state[S_K])
+                    done = True
+                    break
+            if done:
+                break

@@ -1,0 +1,67 @@
+"""Contact in continuous time (kernels.sweep): the swept test misses no contact that sampling the same motion
+ten times as finely finds, finds contacts that fall between the steps, records their own time, and stays
+deterministic; the verifier's distance bound prunes only above the distance where it may still count one."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from cellstress.sim import layout as L
+from cellstress.sim.kernels.dense import dense_batch
+from cellstress.sim.kernels.sweep import flag_distance
+from cellstress.sim.simulator import Simulator
+
+
+def _unswept(sim: Simulator) -> Simulator:
+    scal = sim.params.scal.copy()
+    scal[L.C_SWEEP] = 0.0
+    return Simulator(dataclasses.replace(sim.layout, params=sim.params._replace(scal=scal)), start=sim.start)
+
+
+@pytest.fixture(scope="module")
+def s3():
+    sim = Simulator("s3-fence-gap")
+    acts = np.random.default_rng(0).integers(0, sim.n_actions, size=(1500, sim.actions_per_episode))
+    return sim, acts, sim.run_batch(acts).unsafe_step
+
+
+@pytest.mark.parametrize("cell", ["s3-fence-gap", "s1-scanner-width"])
+def test_no_contact_of_the_fine_samples_is_missed(cell, s3) -> None:
+    sim = s3[0] if cell == "s3-fence-gap" else Simulator(cell)
+    acts = np.random.default_rng(1).integers(0, sim.n_actions, size=(800, sim.actions_per_episode))
+    swept = sim.run_batch(acts).unsafe_step
+    fine = np.empty(len(acts), dtype=np.int64)
+    dense_batch(sim.params, sim.reset(), np.ascontiguousarray(acts), 10, fine)
+    hit = fine >= 0
+    assert np.all((swept[hit] >= 0) & (swept[hit] <= fine[hit]))
+    if cell == "s3-fence-gap":
+        assert hit.sum() > 3  # and the check is not vacuous
+
+
+def test_contacts_between_the_steps_are_found_with_their_time(s3) -> None:
+    sim, acts, swept = s3
+    flat = _unswept(sim)
+    sampled = flat.run_batch(acts).unsafe_step
+    between = np.flatnonzero((swept >= 0) & (sampled < 0))
+    assert len(between) > 0  # the sampled model misses these
+    kinds = set()
+    for e in between[:10]:
+        row = sim.run(acts[e]).rows[-1]
+        assert row[L.M_UNSAFE] == 1.0 and row[L.M_SWEPT] in (1.0, 2.0)
+        kinds.add(int(row[L.M_SWEPT]))
+        assert row[L.M_T] - sim.dt <= row[L.M_TC] < row[L.M_T]  # its own time, within the step
+        # bit for bit again
+        assert np.array_equal(sim.run(acts[e]).rows, sim.run(acts[e]).rows)
+    # a contact at a step's own sample records that step's time
+    own = [sim.run(acts[e]).rows[-1] for e in np.flatnonzero((sampled >= 0) & (swept == sampled))]
+    own = [row for row in own if row[L.M_SWEPT] == 0.0]
+    assert own and all(row[L.M_TC] == row[L.M_T] for row in own)
+
+
+def test_the_flag_distance_is_a_few_millimetres() -> None:
+    P = Simulator("baseline").params
+    extra = flag_distance(P) - float(P.scal[L.C_DTOL])
+    assert 0.0 < extra < 0.02
