@@ -170,6 +170,12 @@ def search(
         creep = " (creeping)" if h.severity is not None and h.severity.creeping else ""
         echo(f"contact   t={num(h.time_s)} s (step {h.step}): {h.robot_link} / {h.body_part} at "
              f"({x:.3f}, {y:.3f}, {z:.3f}) m, robot moving at v_R {h.v_R:.3f} m/s{creep}")
+        hit = h.trace[h.step] if h.step < len(h.trace) else None
+        if hit is not None and hit.between is not None:
+            echo("between   " + ("the contact lies between two time steps (the swept test found it)"
+                                 if hit.between == "contact" else
+                                 "the swept test could not rule out a contact between two time steps: the bodies "
+                                 f"came within {hit.d_HR * 1000:.0f} mm of each other (counted, conservatively)"))
         if h.why is not None:
             echo(f"why       {shortfall(h.why, static)}")
         if h.verdict is not None:  # a criterion that judges contacts: its account of this one

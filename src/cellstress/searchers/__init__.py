@@ -203,7 +203,7 @@ def hazard_record(sim: Simulator, episode: int, actions: list[str]) -> Hazard:
     hit = records[trace.unsafe_row]
     verdict = sim.verdict(trace.rows[trace.unsafe_row])  # a criterion that judges contacts: its account
     return Hazard.model_construct(
-        episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.t, robot_link=hit.robot_link,
+        episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.moment, robot_link=hit.robot_link,
         body_part=hit.body_part, point=hit.robot_point, human_point=hit.human_point, v_R=hit.v_R, d_HR=hit.d_HR,
         trace=records, why=explain(trace.layout, records, trace.unsafe_row),
         severity=severity(hit.v_R, None if verdict is None else verdict.as_dict()),
@@ -216,7 +216,7 @@ def distinct_record(sim: Simulator, klass, episode: int, actions: list[str]) -> 
     hit = records[trace.unsafe_row]
     verdict = sim.verdict(trace.rows[trace.unsafe_row])
     return DistinctHazard.model_construct(
-        klass=klass, episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.t,
+        klass=klass, episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.moment,
         robot_link=hit.robot_link, body_part=hit.body_part, v_R=hit.v_R, trace=records,
         why=explain(trace.layout, records, trace.unsafe_row),
         severity=severity(hit.v_R, None if verdict is None else verdict.as_dict()))

@@ -41,11 +41,24 @@ class StepRecord(Record):
     limbs: Annotated[tuple[float, ...], Field(min_length=11, max_length=11)] | None = None
     """The articulated worker's hip drop [m] and arm joints [deg] (left arm's five, then the right's, in
     human.reach's order); absent for the paper's worker."""
+    between: Literal["contact", "not-ruled-out"] | None = None
+    """A contact the swept test found between the previous step and this one ("contact"), or one it could not
+    rule out at its finest sub-step ("not-ruled-out": the bodies came within ``kernels.sweep.flag_distance``);
+    the pose, points and speeds are then those of that moment. Absent: the step's own sample."""
+    contact_t: float | None = None
+    """The moment of that contact [s] (between t - dt and t); absent with ``between``."""
+
+    @property
+    def moment(self) -> float:
+        """When the row's contact (or closest approach) happens: ``contact_t`` if it lies between the steps."""
+        return self.t if self.contact_t is None else self.contact_t
 
     @model_serializer(mode="wrap")
-    def _without_absent_limbs(self, handler):
-        # (the paper worker's records stay as they were: no "limbs": null in every step of a result file)
+    def _without_absent_fields(self, handler):
+        # (records stay as they were: no "limbs": null for the paper worker, no "between": null at every step)
         doc = handler(self)
-        if isinstance(doc, dict) and doc.get("limbs") is None:
-            doc.pop("limbs", None)
+        if isinstance(doc, dict):
+            for key in ("limbs", "between", "contact_t"):
+                if doc.get(key) is None:
+                    doc.pop(key, None)
         return doc

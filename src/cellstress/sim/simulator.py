@@ -79,7 +79,12 @@ def step_record(row: np.ndarray, layout: Layout) -> StepRecord:
         human_point=tuple(float(v) for v in row[L.M_HX:L.M_HZ + 1]),
         unsafe=bool(row[L.M_UNSAFE]),
         limbs=limbs_record(row) if layout.worker.articulated else None,
+        between=BETWEEN.get(int(row[L.M_SWEPT])),
+        contact_t=round(float(row[L.M_TC]), 9) if int(row[L.M_SWEPT]) in BETWEEN else None,
     )
+
+
+BETWEEN = {1: "contact", 2: "not-ruled-out"}  # M_SWEPT's values (sim.layout.ROW) as StepRecord.between says them
 
 
 def limbs_record(row: np.ndarray) -> tuple[float, ...]:
