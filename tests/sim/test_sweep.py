@@ -53,12 +53,18 @@ def test_contacts_between_the_steps_are_found_with_their_time(s3) -> None:
         assert row[L.M_UNSAFE] == 1.0 and row[L.M_SWEPT] in (1.0, 2.0)
         kinds.add(int(row[L.M_SWEPT]))
         assert row[L.M_T] - sim.dt <= row[L.M_TC] < row[L.M_T]  # its own time, within the step
+        rec = sim.run(acts[e]).records()[-1]  # and the record says so, with that time
+        assert rec.between == ("contact" if row[L.M_SWEPT] == 1.0 else "not-ruled-out")
+        assert rec.contact_t == rec.moment and rec.t - sim.dt <= rec.contact_t < rec.t
         # bit for bit again
         assert np.array_equal(sim.run(acts[e]).rows, sim.run(acts[e]).rows)
     # a contact at a step's own sample records that step's time
     own = [sim.run(acts[e]).rows[-1] for e in np.flatnonzero((sampled >= 0) & (swept == sampled))]
     own = [row for row in own if row[L.M_SWEPT] == 0.0]
     assert own and all(row[L.M_TC] == row[L.M_T] for row in own)
+    rec = sim.run(acts[np.flatnonzero((sampled >= 0) & (swept == sampled))[0]]).records()[-1]
+    if rec.between is None:  # a step's own contact: the record is as it always was
+        assert "between" not in rec.model_dump() and "contact_t" not in rec.model_dump() and rec.moment == rec.t
 
 
 def test_the_flag_distance_is_a_few_millimetres() -> None:
