@@ -11,7 +11,7 @@ import pytest
 
 from cellstress.sim import layout as L
 from cellstress.sim.kernels.dense import dense_batch
-from cellstress.sim.kernels.sweep import flag_distance
+from cellstress.sim.kernels.sweep import _moving_time, flag_distance
 from cellstress.sim.simulator import Simulator
 
 
@@ -71,3 +71,28 @@ def test_the_flag_distance_is_a_few_millimetres() -> None:
     P = Simulator("baseline").params
     extra = flag_distance(P) - float(P.scal[L.C_DTOL])
     assert 0.0 < extra < 0.02
+
+
+def test_moving_time_leaves_out_the_dwells() -> None:
+    """_moving_time against counting 0.1 ms samples of the same path (dwell then move per segment, cyclic,
+    a padded row of another robot included)."""
+    starts = np.array([0.0, 1.0, 1.5, 3.0, np.inf])
+    dwell = np.array([0.4, 0.0, 0.5, 0.0, 0.0])
+    move = np.array([0.6, 0.5, 1.0, 1.0, 1.0])
+    cycle = 4.0
+    rng = np.random.default_rng(3)
+
+    def moving(t):
+        tc = t % cycle
+        i = int(np.searchsorted(starts[:4], tc, side="right")) - 1
+        return tc >= starts[i] + dwell[i]
+
+    for _ in range(200):
+        a = float(rng.uniform(-3.0, 9.0))
+        b = a + float(rng.choice([rng.uniform(0.0, 0.05), rng.uniform(0.0, 5.0)]))
+        got = _moving_time(cycle, starts, move, dwell, a, b)
+        n = max(1, int(round((b - a) / 1e-4)))
+        ts = a + (np.arange(n) + 0.5) * (b - a) / n
+        want = (b - a) * np.mean([moving(t) for t in ts]) if b > a else 0.0
+        assert abs(got - want) <= 2e-4 + 1e-9 and got == _moving_time(cycle, starts, move, dwell, b, a)
+    assert _moving_time(cycle, starts, move, dwell, 0.1, 0.3) == 0.0  # inside the first dwell

@@ -35,7 +35,7 @@ from cellstress.sim.kernels.body import pose_body
 from cellstress.sim.kernels.fences import blocking_panel, collect_near_fences, fence_detour_bound
 from cellstress.sim.kernels.params import SWEEP_CERTIFIED, SWEEP_DEPTH
 from cellstress.sim.kernels.reach import TRACE_REL_TOL, reach_field_at
-from cellstress.sim.kernels.robot import _robot_live, live_path_time, path_time
+from cellstress.sim.kernels.robot import _robot_live, _segment, live_path_time, path_time
 from cellstress.sim.kernels.separation import separation
 from cellstress.sim.layout import (
     A_DROP,
@@ -48,6 +48,7 @@ from cellstress.sim.layout import (
     B_N_CAPS,
     B_WALK_SPEED,
     C_ANY_MOTION,
+    C_CYCLE,
     C_DT,
     C_DTOL,
     C_REACH_H,
@@ -109,27 +110,70 @@ def _path_time(scal, prev, state, t0, t):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _moving_time(cycle, seg_start, seg_move, seg_dwell, ta, tb):
+    """How much of the path time between ta and tb the path spends moving (its dwells at the waypoints left out):
+    nothing of a robot moves while its path dwells, whatever the path time does."""
+    lo, hi = (ta, tb) if ta <= tb else (tb, ta)
+    if hi - lo >= cycle:
+        return hi - lo
+    t = lo - cycle * np.floor(lo / cycle)
+    left = hi - lo
+    out = 0.0
+    i = _segment(seg_start, t)
+    n = seg_start.shape[0]
+    for _ in range(2 * n + 2):  # at most once round the cycle (a padded row of another robot starts at inf)
+        if left <= 0.0:
+            return out
+        # segment i: dwell on [seg_start, seg_start + dwell), then the move until the next segment's start
+        move_from = seg_start[i] + seg_dwell[i]
+        end = move_from + seg_move[i]
+        if t < move_from:
+            gap = move_from - t
+            if gap >= left:
+                return out
+            t, left = move_from, left - gap
+        run = end - t
+        if run >= left:
+            return out + left
+        if run > 0.0:
+            out += run
+            left -= run
+        t = end
+        i += 1
+        if i >= n or seg_start[i] == np.inf:  # round the cycle's end
+            i, t = 0, 0.0
+    return out if left <= 0.0 else hi - lo
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _robot_travel(P, prev, state, t0, ta, tb):
     """How far any point of any robot capsule can move between ta and tb; and whether every robot stands
-    throughout."""
+    throughout, stopped or dwelling at a waypoint (``still``: whether that holds for a reason other than a stop,
+    which only the speed test may use)."""
     tau_a, _, ph_a = _path_time(P.scal, prev, state, t0, ta)
     tau_b, _, ph_b = _path_time(P.scal, prev, state, t0, tb)
     standing = ph_a == PHASE_STOPPED and ph_b == PHASE_STOPPED
+    run0 = _moving_time(P.scal[C_CYCLE], P.seg_start, P.seg_move, P.seg_dwell, tau_a, tau_b)
+    still = run0 == 0.0
     worst = 0.0
     nx = P.x_scal.shape[0]
     for c in range(P.cap_speed.shape[0]):
         r = P.cap_robot[c]
         if r == 0:
-            move = P.cap_speed[c] * abs(tau_b - tau_a)
+            move = P.cap_speed[c] * run0
         else:
-            xa, _, pa = path_time(P.x_scal[r - 1], ta, prev[S_XTSTOP + r - 1])
-            xb, _, pb = path_time(P.x_scal[r - 1], tb, prev[S_XTSTOP + r - 1])
-            move = P.cap_speed[c] * abs(xb - xa)
+            xs = P.x_scal[r - 1]
+            xa, _, pa = path_time(xs, ta, prev[S_XTSTOP + r - 1])
+            xb, _, pb = path_time(xs, tb, prev[S_XTSTOP + r - 1])
+            run = _moving_time(xs[C_CYCLE], P.x_seg_start[r - 1], P.x_seg_move[r - 1], P.x_seg_dwell[r - 1], xa, xb)
+            move = P.cap_speed[c] * run
             if r <= nx and not (pa == PHASE_STOPPED and pb == PHASE_STOPPED):
                 standing = False
+            if run != 0.0:
+                still = False
         if move > worst:
             worst = move
-    return worst, standing
+    return worst, standing, still
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -293,9 +337,10 @@ def sweep_step(P, prev, state, W, row):
         ta, tb = t0 + sa * dt, t0 + sb * dt
         if ta >= found_t:
             continue  # after the contact already found
-        robot, standing = _robot_travel(P, prev, state, t0, ta, tb)
-        if standing and not judged:
-            continue  # no contact with a moving robot
+        robot, standing, still = _robot_travel(P, prev, state, t0, ta, tb)
+        if not judged and (standing or (still and scal[C_ANY_MOTION] == 0.0)):
+            continue  # no contact with a moving robot (a dwelling one has v_R 0; the arrival-window test asks
+            # only whether it is stopped)
         moves = 0.5 * REACH_SLOPE * (travel * (sb - sa) + robot)
         if cert != 0.0:  # certified lower bounds at both ends
             near = 0.5 * (da + db) - moves
