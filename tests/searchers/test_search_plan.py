@@ -15,6 +15,7 @@ from cellstress.cli import main
 from cellstress.criteria.contact import ContactWhileMoving
 from cellstress.searchers import SearchError, run_search, searcher_class
 from cellstress.searchers.plan import Plan, _Model
+from cellstress.searchers.result import SearchResult
 from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
 
@@ -80,10 +81,20 @@ def test_result_file_is_byte_identical(tmp_path, capsys) -> None:
 def test_refuses_what_it_cannot_search(tmp_path, capsys) -> None:
     with pytest.raises(SearchError, match="cell's simulator"):
         run_search(ToyWalk(), ContactWhileMoving().reward(8), "plan", 20, 0)
-    # several start points: one line, exit 2
-    code = main(["search", "all-flaws", "--searcher", "plan", "--budget", "20", "--out", str(tmp_path / "af")])
-    err = capsys.readouterr().err
-    assert code == 2 and "add --distinct" in err and err.count("\n") == 1
+
+
+def test_several_start_points_as_they_are(tmp_path, capsys) -> None:
+    """Issue 34.6: `search CELL --searcher plan` on a cell with several start points gives the first hazard (the
+    budget shared between the start points in slices), with no --distinct, and the same bytes twice."""
+    args = ["search", "all-flaws", "--searcher", "plan", "--budget", "200", "--seed", "0", "--no-report"]
+    for d in ("a", "b"):
+        assert main([*args, "--out", str(tmp_path / d)]) == 0
+    capsys.readouterr()
+    res = SearchResult.load(tmp_path / "a" / "result.json")
+    assert res.found and res.until == "first" and res.distinct is None
+    assert res.episodes == res.hazard.episode < 200  # stopped at the first hazard
+    assert res.hazard.actions[0].startswith("start:")
+    assert (tmp_path / "a" / "result.json").read_bytes() == (tmp_path / "b" / "result.json").read_bytes()
 
 
 @pytest.mark.parametrize("options", [{"n_init": 0}, {"candidates": 0}, {"pool": 1.5}, {"explore": 1.5},

@@ -36,7 +36,7 @@ from cellstress.searchers.result import (
     TopEpisode,
 )
 from cellstress.searchers.severity import severity, worst_first
-from cellstress.searchers.slices import ClassRecorder, cell_starts, run_slices
+from cellstress.searchers.slices import SLICE_LEN, ClassRecorder, cell_starts, run_slices
 from cellstress.searchers.why import explain
 from cellstress.sim.simulator import Simulator
 
@@ -121,7 +121,7 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
     from classes already found (``search.distinct``); the result lists each class's first hazard. A cell with
     several start points (``human.starts``) lets each episode's first decision pick one (``search.multistart``);
     with ``evolve`` and ``plan`` the distinct mode instead shares the budget between the start points in slices
-    (``search.slices``; ``plan`` needs it on such a cell).
+    (``search.slices``), and ``plan``, which searches one start point's problem, always does so on such a cell.
     """
     check_common(budget, seed, until, top_k)
     s = make_searcher(searcher, **options)
@@ -138,14 +138,16 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
         names = problem.names
     rec = None
     missing = [p.__name__ for p in getattr(type(s), "needs", ()) if not isinstance(problem, p)]
-    if missing and not (distinct and type(s).whole_episodes):
-        raise SearchError(f"searcher {s.name!r} needs a problem with {', '.join(missing)}"
-                          + (" (on a cell with several start points, add --distinct: each start point then gets "
-                             "its own searches)" if c.spec.human.starts else ""))
-    if distinct and type(s).whole_episodes:  # the budget in slices shared by the starts
+    if missing and not type(s).whole_episodes:
+        raise SearchError(f"searcher {s.name!r} needs a problem with {', '.join(missing)}")
+    if (distinct or missing) and type(s).whole_episodes:
+        # the budget in slices shared by the starts: the distinct mode, and the way a searcher that needs one start
+        # point's problem (plan) searches a cell with several (each slice searches one of them)
         starts = cell_starts(problem, reward)
         rec = ClassRecorder(int(budget), until, int(top_k), progress, n_starts=len(starts))
-        out = run_slices(s, starts, reward, rec, int(seed))
+        # (the distinct mode's slices are measured; for the first hazard every start point gets its share early)
+        slice_len = SLICE_LEN if distinct else min(SLICE_LEN, max(1, int(budget) // len(starts)))
+        out = run_slices(s, starts, reward, rec, int(seed), slice_len)
     else:
         if distinct:
             problem = distinct_problem(problem, sim, reward)
@@ -181,7 +183,7 @@ def search(cell, searcher: str = "mcts", budget: int = DEFAULT_BUDGET, seed: int
         distinct_sequences=out.distinct_sequences,
         version=__version__,
         format=FORMAT,
-        distinct=None if rec is None else tuple(worst_first([
+        distinct=None if rec is None or not distinct else tuple(worst_first([
             distinct_record(sim, hazard_class_record(key), episode, names(actions))
             for key, (episode, actions) in rec.classes.items()])),
     )

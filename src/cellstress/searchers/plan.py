@@ -104,8 +104,8 @@ class Plan:
 
     def run(self, problem, reward, rec: Recorder, seed: int) -> None:
         if not isinstance(problem, WorkerModel):
-            raise SearchError("plan searches a cell's simulator from one start point (for a cell with several, "
-                              "add --distinct: each start point then gets its own searches)")
+            raise SearchError("plan searches a cell's simulator from one start point (search() gives each start "
+                              "point of a cell with several its own searches)")
         rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(PLAN_KEY,)))
         horizon, n_actions = problem.actions_per_episode, problem.n_actions
         # a cell whose arrival phase is searched: the first decision is the phase (multistart.PhaseProblem)
