@@ -14,7 +14,7 @@ import cellstress
 from cellstress.sim import layout as L
 from cellstress.sim.scene import robot_capsules
 from cellstress.sim.simulator import Simulator
-from cellstress.verifier.arrival import arrival_cover, capsule_margins, clock_dependence, inflated
+from cellstress.verifier.arrival import REACH_LIPSCHITZ, arrival_cover, capsule_margins, clock_dependence, inflated
 from cellstress.verifier.phases import start_points
 from cellstress.verifier.records import PROVED_SAFE, UNSAFE
 
@@ -31,7 +31,7 @@ def test_margins_hold_every_capsule_position_of_the_window(cell) -> None:
     sim = Simulator(_cell(cell))
     lay = sim.layout
     half = 0.5 * sim.dt
-    margins = capsule_margins(lay, half) - float(lay.params.scal[L.C_REACH_H])
+    margins = (capsule_margins(lay, half) - float(lay.params.scal[L.C_REACH_H])) / REACH_LIPSCHITZ
     rng = np.random.default_rng(5)
     tau0 = float(lay.params.scal[L.C_PHASE0])
     worst = np.zeros(len(lay.capsules))
