@@ -34,8 +34,11 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+from scipy import ndimage
 
 from cellstress.analysis.check_text import check_lines
+from cellstress.analysis.espe_rules import entry_covers
+from cellstress.analysis.floor_fill import GRID, detection_margin, floor_fill
 from cellstress.analysis.hazard_zone import Closest, HazardZone, closest_on_zone, hazard_zone, segment_to_zone
 from cellstress.analysis.muting import muting_checks
 from cellstress.analysis.plane import (
@@ -55,13 +58,11 @@ from cellstress.cell.load import Cell, load_cell
 from cellstress.core.iso13857 import NO_BARRIER_BELOW_MM
 from cellstress.core.records import DoorLeaf, ScanPlane, VerticalField
 from cellstress.devices.base import DeviceRecord, stops_robot
-from cellstress.human.body import WALK_BLOCK_HEIGHT
 from cellstress.robot.stopping import RobotStop
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 from cellstress.sim.build import build_layout
 
-GRID = 0.05  # m, flood-fill grid
 ARM_ALLOWANCE = 0.85  # m, ISO 13857 reach of the arm up to the armpit (also ISO 13855's C for body detection)
 LOW_FENCE = NO_BARRIER_BELOW_MM / 1000.0  # m, ISO 13857 4.2.2: a structure lower than this is no barrier
 
@@ -188,28 +189,6 @@ class StaticCheck:
 # ---- the cell's parts -------------------------------------------------------------------------------------
 
 
-def _upright_capsule_bands(body: np.ndarray) -> list[tuple[float, float, float]]:
-    """(z low, z high, radius) of the upright worker's body capsules (kernels.human_pose at zero flexion)."""
-    hip = body[L.B_HIP_Z]
-    shoulder = hip + body[L.B_SHOULDER_RISE]
-    arm_low = max(shoulder - (body[L.B_ARM_LEN] - body[L.B_R_ARM]), body[L.B_R_ARM])
-    head = hip + body[L.B_HEAD_RISE]
-    rl, rt, rh, ra = body[L.B_R_LEG], body[L.B_R_TRUNK], body[L.B_R_HEAD], body[L.B_R_ARM]
-    return [(0.0, hip + rl, rl), (hip - rt, hip + body[L.B_TRUNK_TOP] + rt, rt),
-            (head - rh, head + rh, rh), (arm_low - ra, shoulder + ra, ra)]
-
-
-def detection_margin(body: np.ndarray, lo: float, hi: float) -> float:
-    """How close (plan view) the worker's centre may come to a detection zone spanning heights lo..hi unseen.
-
-    Facing the zone, every body capsule's axis lies on the line through the centre parallel to the zone's
-    edge (legs and arms are side by side), so the worker stays unseen while the centre is farther than the
-    largest radius among the capsules that reach into the height band.
-    """
-    radii = [r for (zl, zh, r) in _upright_capsule_bands(body) if zl <= hi and zh >= lo]
-    return max(radii) if radii else 0.0
-
-
 def lean_reach(layout) -> float:
     """Largest horizontal distance from the hip centre to a shoulder joint over all trunk postures."""
     P = layout.params
@@ -225,11 +204,6 @@ def lean_reach(layout) -> float:
     return best
 
 
-def _walk_blocking_fences(spec):
-    return [(a, b) for f in spec.fences if f.bottom < WALK_BLOCK_HEIGHT
-            for a, b in zip(f.points, f.points[1:], strict=False)]
-
-
 # ---- the checks -------------------------------------------------------------------------------------------
 def episode_length(spec) -> float:
     sim = spec.simulation
@@ -243,13 +217,7 @@ def _device_checks(spec, zone: HazardZone, robot_stop: RobotStop, robot: str = "
     stop = robot_stop.to_standstill
     delay, braking = robot_stop.delay, robot_stop.braking
     t_ep = episode_length(spec)
-    fl = spec.floor
-    floor_edges = [((fl.xmin, fl.ymin), (fl.xmax, fl.ymin)), ((fl.xmax, fl.ymin), (fl.xmax, fl.ymax)),
-                   ((fl.xmax, fl.ymax), (fl.xmin, fl.ymax)), ((fl.xmin, fl.ymax), (fl.xmin, fl.ymin))]
-    covers = list(_walk_blocking_fences(spec)) + floor_edges
-    for ob in spec.solid_obstacles():  # the worker cannot walk into an obstacle: its edges are no way in
-        poly = ob.footprint()
-        covers += [(poly[i], poly[(i + 1) % len(poly)]) for i in range(len(poly))]
+    covers = entry_covers(spec)
     out = []
     for d in spec.devices:
         iso = d.stop_distance(delay, braking) if isinstance(d, DeviceRecord) else d.required_distance(stop)
@@ -327,46 +295,15 @@ def _approach_check(spec, layout, zone: HazardZone, vol: HazardVolume, panels, l
     """The undetected reach from the start point; with ``behind`` (a device's detection primitive), from every
     floor region next to that zone instead: where a worker who crossed it stands once it no longer sees them
     (what an automatic restart lets the robot meet)."""
-    from scipy import ndimage
-
     body = layout.params.body
     radius = float(body[L.B_BODY_RADIUS])
     fl = spec.floor
     h = GRID
-    nx = int(round((fl.xmax - fl.xmin) / h))
-    ny = int(round((fl.ymax - fl.ymin) / h))
-    xs = fl.xmin + (np.arange(nx) + 0.5) * h
-    ys = fl.ymin + (np.arange(ny) + 0.5) * h
-    X, Y = np.meshgrid(xs, ys)  # (ny, nx)
-    ok = (X - radius >= fl.xmin) & (X + radius <= fl.xmax) & (Y - radius >= fl.ymin) & (Y + radius <= fl.ymax)
-    for ob in spec.solid_obstacles():  # (the robot's pedestal stands inside the hazard zone: no matter)
-        poly = ob.footprint()
-        ok &= ~points_in_polygon(X, Y, poly) & (distance_to_polyline(X, Y, poly, True) >= radius)
-    for a, b in _walk_blocking_fences(spec):
-        ok &= point_segment(X, Y, a[0], a[1], b[0], b[1])[0] >= radius
-    m_scan: float | None = None
-    m_curtain: float | None = None
-    curtains = []
-    for prim in (p for d in spec.devices for p in d.primitives()):
-        if isinstance(prim, ScanPlane):
-            m = detection_margin(body, prim.height, prim.height)
-            m_scan = m if m_scan is None else max(m_scan, m)
-            ok &= ~points_in_polygon(X, Y, prim.polygon) & (distance_to_polyline(X, Y, prim.polygon, True) > m)
-        else:
-            m = detection_margin(body, prim.bottom, prim.top)
-            m_curtain = m if m_curtain is None else max(m_curtain, m)
-            ok &= point_segment(X, Y, prim.start[0], prim.start[1], prim.end[0], prim.end[1])[0] > m
-            curtains.append((tuple(prim.start), tuple(prim.end)))
+    ff = floor_fill(spec, body)
+    X, Y, xs, ys, labels, U, detected = ff.X, ff.Y, ff.xs, ff.ys, ff.labels, ff.U, ff.detected
+    ok, m_scan, m_curtain, curtains = ff.ok, ff.m_scan, ff.m_curtain, list(ff.curtains)
+    ny, nx = ok.shape
     sx, sy = spec.human.start.xy
-    ix = min(max(int((sx - fl.xmin) / h), 0), nx - 1)
-    iy = min(max(int((sy - fl.ymin) / h), 0), ny - 1)
-    labels, _ = ndimage.label(ok)
-    seed = labels[iy, ix]
-    if seed == 0:  # the start cell's centre is a little off the start point: try the neighbours
-        near = labels[max(iy - 1, 0):iy + 2, max(ix - 1, 0):ix + 2]
-        seed = int(near.max())
-    detected = seed == 0
-    U = (labels == seed) if not detected else np.zeros_like(ok)
     if behind is not None:  # every region that touches the zone's margin (plus two grid cells): either side
         if isinstance(behind, ScanPlane):
             reach = detection_margin(body, behind.height, behind.height) + 2 * h
