@@ -37,10 +37,11 @@ import numpy as np
 from scipy import ndimage
 
 from cellstress.analysis.check_text import check_lines
-from cellstress.analysis.espe_rules import entry_covers
+from cellstress.analysis.espe_rules import curtain_reach_over, device_rules, entry_covers, failure_name
 from cellstress.analysis.floor_fill import GRID, detection_margin, floor_fill
 from cellstress.analysis.hazard_zone import Closest, HazardZone, closest_on_zone, hazard_zone, segment_to_zone
 from cellstress.analysis.muting import muting_checks
+from cellstress.analysis.openings import perimeter_openings
 from cellstress.analysis.plane import (
     closest_reach,
     detour_nodes,
@@ -58,6 +59,7 @@ from cellstress.cell.load import Cell, load_cell
 from cellstress.core.iso13857 import NO_BARRIER_BELOW_MM
 from cellstress.core.records import DoorLeaf, ScanPlane, VerticalField
 from cellstress.devices.base import DeviceRecord, stops_robot
+from cellstress.devices.light_curtain import LightCurtain
 from cellstress.robot.stopping import RobotStop
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
@@ -162,6 +164,8 @@ class StaticCheck:
     robot_cycles: tuple[tuple[str, float], ...] = ()  # several robots: each one's cycle time [s]
     mutings: tuple = ()  # analysis.muting.MutingCheck of every muted light curtain
     speeds: tuple = ()  # analysis.stopping.SpeedCheck: each configured device speed against the robot's real one
+    openings: tuple = ()  # analysis.openings.Opening: every opening in the perimeter, against the whole body
+    access: tuple = ()  # analysis.espe_rules records: getting over, under or across the devices (ISO 13855)
 
     @property
     def ok(self) -> bool:
@@ -170,7 +174,10 @@ class StaticCheck:
     def failures(self) -> list[str]:
         """Names of the failed checks: device names, 'undetected-reach', 'reach-over' (ISO 13857 Table 2),
         'DEVICE-restart', 'DEVICE-muting', 'DEVICE-speed' (a configured speed below the robot's real one; in a
-        cell of several robots, with ':ROBOT' after a device's or the reach checks' names)."""
+        cell of several robots, with ':ROBOT' after a device's or the reach checks' names), 'whole-body-opening'
+        (an opening in the perimeter the body passes unseen), 'DEVICE-reach-over' (over a curtain's top, with
+        ':ROBOT' in a cell of several), 'DEVICE-crawl-under', 'DEVICE-step-over', 'DEVICE-mounting' (a scanner
+        lower than its resolution allows), 'DEVICE-depth' (a mat that can be stepped across)."""
         out = [d.device + (f":{d.robot}" if d.robot else "") for d in self.devices if not d.ok]
         for a in (self.approach, *self.robot_approaches):
             if not a.ok:
@@ -180,6 +187,9 @@ class StaticCheck:
         out += [f"{r.device}-restart" for r in self.restarts if not r.ok]
         out += [f"{m.device}-muting" for m in self.mutings if not m.ok]
         out += [f"{s.device}-speed" for s in self.speeds if not s.ok]
+        if any(not o.ok for o in self.openings):
+            out.append("whole-body-opening")
+        out += [name for rule in self.access for name in failure_name(rule)]
         return out
 
     def lines(self) -> list[str]:
@@ -401,7 +411,26 @@ def check_cell(cell: Cell | str | Path, layout=None) -> StaticCheck:
                        episode_length(spec), spec.human.arrival == "fixed",
                        _restart_checks(spec, layout, zone, vol, panels, lean), more,
                        tuple((p.name, float(p.trajectory.cycle)) for p in layout.robots) if more else (),
-                       muting_checks(spec), speed_checks(layout))
+                       muting_checks(spec), speed_checks(layout),
+                       perimeter_openings(spec, floor_fill(spec, body), float(body[L.B_BODY_RADIUS])),
+                       _access_rules(spec, layout, devices, vol))
+
+
+def _access_rules(spec, layout, devices, vol: HazardVolume) -> tuple:
+    """Reach over every light curtain's top (for each robot it stops, with that robot's T and hazard zone), then
+    the rules of ``espe_rules.device_rules``."""
+    by_name = {d.name: d for d in spec.devices}
+    names = [r.name for r in spec.robots]
+    vols: dict[str, HazardVolume] = {}
+    out = []
+    for row in devices:
+        dev = by_name.get(row.device)
+        if not isinstance(dev, LightCurtain) or row.type != dev.type:
+            continue
+        if row.robot and row.robot not in vols:
+            vols[row.robot] = hazard_volume(layout, robot=names.index(row.robot))
+        out.append(curtain_reach_over(dev, vols.get(row.robot, vol), row.T, row.required, row.robot))
+    return tuple(out) + device_rules(spec)
 
 
 def _per_robot(spec, layout, lean: float) -> tuple[tuple[DeviceCheck, ...], list[ApproachCheck]]:
