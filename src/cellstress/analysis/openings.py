@@ -3,7 +3,8 @@ wider than 180 mm, a square or round opening wider than 240 mm), for the static 
 
 **The openings looked at.** (1) The gap under every fence panel or guard door raised off the floor: bottom x panel
 length. (2) The gap from every free end of a fence (an end that meets no other panel) to the nearest point of each
-other barrier: another fence (its other panels included), a door leaf, the table, an obstacle, the floor's edge;
+segment of every barrier: a fence's panels (its own far ones included), a door leaf, the edges of the table and of
+the obstacles, the floor's edge;
 its height is the lower of the two barriers' tops, and a gap whose line crosses another barrier is none. The cell
 format has no solid above a panel, so there is no gap over a panel's top to look at.
 
@@ -189,19 +190,19 @@ def candidate_openings(spec) -> list[tuple[str, str, tuple, tuple, float]]:
                 out.append(("under", f"under door {d.name}", tuple(map(float, p.start)), tuple(map(float, p.end)),
                             float(p.bottom)))
     for i, end, own in _free_ends(spec, barriers):
-        for k, br in enumerate(barriers):
-            segs = [s for j, s in enumerate(br.segments) if not (k == i and j == own)]
-            if not segs:
-                continue
-            d, q = _nearest_on(end, segs)
-            if d <= JOIN_TOL or _blocked(end, q, barriers):
-                continue
-            key = tuple(sorted((tuple(np.round(end, 4)), tuple(np.round(q, 4)))))
-            if key in seen:
-                continue
-            seen.add(key)
-            top = min(float(spec.fences[i].top), br.top)
-            out.append(("gap", f"gap from fence {i + 1}'s end to {br.name}", end, q, top))
+        for k, br in enumerate(barriers):  # each segment of each barrier: a fence's own far panels included
+            for j, seg in enumerate(br.segments):
+                if k == i and j == own:
+                    continue
+                d, q = _nearest_on(end, [seg])
+                if d <= JOIN_TOL or _blocked(end, q, barriers):
+                    continue
+                key = tuple(sorted((tuple(np.round(end, 4)), tuple(np.round(q, 4)))))
+                if key in seen:
+                    continue
+                seen.add(key)
+                top = min(float(spec.fences[i].top), br.top)
+                out.append(("gap", f"gap from fence {i + 1}'s end to {br.name}", end, q, top))
     return out
 
 
