@@ -25,6 +25,9 @@ The reasoning behind every number is in docs/cells.md. In short:
   4.2.2), one raised off the floor lets the arm under it (ISO 13857's tables for reaching under, Tables 6 and
   7, are for the lower limbs and not in ``core.iso13857``), and one that does not meet Table 2 lets it over:
   these three count as open in the undetected reach.
+* **Ways in** (issue 34): openings in the perimeter the whole body passes unseen (ISO 13857's 180 / 240 mm,
+  ``analysis.openings``); reaching over a light curtain (ISO 13855 C_RO), crawling under or stepping over it, a
+  scanner's mounting height against its resolution, a mat's depth (``analysis.espe_rules``).
 """
 
 from __future__ import annotations

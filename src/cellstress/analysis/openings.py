@@ -5,7 +5,8 @@ wider than 180 mm, a square or round opening wider than 240 mm), for the static 
 length. (2) The gap from every free end of a fence (an end that meets no other panel) to the nearest point of each
 segment of every barrier: a fence's panels (its own far ones included), a door leaf, the edges of the table and of
 the obstacles, the floor's edge;
-its height is the lower of the two barriers' tops, and a gap whose line crosses another barrier is none. The cell
+its height is the lower of the two barriers' tops. A line that crosses another barrier, or runs from the end back
+beside its own wall (the point lies behind the end along the end's panel), is no opening. The cell
 format has no solid above a panel, so there is no gap over a panel's top to look at.
 
 **Shape.** An opening w x h: if its longer side is at most 240 mm it fits in a 240 mm square, which no body passes
@@ -175,6 +176,15 @@ def _free_ends(spec, barriers) -> list[tuple[int, tuple[float, float], int]]:
     return out
 
 
+def _ahead(fence, own: int, end, q) -> bool:
+    """Whether q lies ahead of or beside the fence's free ``end`` (not back along the fence's own end panel): a
+    gap opens from the end of a wall; a line from the end back across the floor beside the wall is no opening."""
+    a, b = fence.points[own], fence.points[own + 1]
+    other = b if tuple(map(float, a)) == tuple(end) else a
+    ux, uy = end[0] - other[0], end[1] - other[1]
+    return (q[0] - end[0]) * ux + (q[1] - end[1]) * uy >= -1e-9 * math.hypot(ux, uy)
+
+
 def candidate_openings(spec) -> list[tuple[str, str, tuple, tuple, float]]:
     """(kind, where, start, end, clear height) of every opening to look at, without duplicates."""
     barriers = _barriers(spec)
@@ -195,7 +205,7 @@ def candidate_openings(spec) -> list[tuple[str, str, tuple, tuple, float]]:
                 if k == i and j == own:
                     continue
                 d, q = _nearest_on(end, [seg])
-                if d <= JOIN_TOL or _blocked(end, q, barriers):
+                if d <= JOIN_TOL or not _ahead(spec.fences[i], own, end, q) or _blocked(end, q, barriers):
                     continue
                 key = tuple(sorted((tuple(np.round(end, 4)), tuple(np.round(q, 4)))))
                 if key in seen:
