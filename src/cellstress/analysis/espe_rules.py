@@ -173,8 +173,8 @@ class ScannerMounting:
 
     @property
     def c_mm(self) -> float:
-        """The intrusion allowance the field's distance uses, C = 1200 - 0.4 H, not below 850 mm."""
-        return max(I.MIN_C_BODY, 1200.0 - 0.4 * self.height * 1000.0)
+        """The intrusion allowance the field's distance uses (``devices.laser_scanner`` takes the same function)."""
+        return I.horizontal_c_mm(self.height * 1000.0)
 
     @property
     def resolution_ok(self) -> bool:

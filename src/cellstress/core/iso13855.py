@@ -27,6 +27,11 @@ MAT_MIN_DEPTH_MM = 750.0  # a pressure-sensitive mat this deep cannot be stepped
 K_REACH_OVER = K_WALK  # mm/s in S_RO = K T + C_RO (as the curtain's through-distance with body sensing)
 
 
+def horizontal_c_mm(height_mm: float) -> float:
+    """ISO 13855:2010, detection zone parallel to the approach: C = 1200 - 0.4 H [mm], not below 850 mm."""
+    return max(MIN_C_BODY, 1200.0 - 0.4 * height_mm)
+
+
 def min_scan_height_mm(d_mm: float) -> float:
     """ISO 13855:2010, horizontal detection zone: the lowest scan plane for detection capability d, 15 (d - 50) mm,
     never below the floor."""

@@ -19,7 +19,7 @@ from typing import Annotated, ClassVar, Literal
 from pydantic import Field, model_validator
 
 from cellstress.core.fields import Polygon, PositiveTime, Record
-from cellstress.core.iso13855 import K_WALK, MIN_C_BODY, mm
+from cellstress.core.iso13855 import K_WALK, horizontal_c_mm, mm
 from cellstress.core.plane import polygon_outside_point
 from cellstress.core.records import Channel, IsoDistance, ScanPlane
 from cellstress.devices.base import DeviceRecord, Restart
@@ -42,7 +42,7 @@ class WarningField(Record):
 
 
 def _c(height_mm: float) -> float:
-    return max(MIN_C_BODY, 1200.0 - 0.4 * height_mm)
+    return horizontal_c_mm(height_mm)
 
 
 class LaserScanner(DeviceRecord):
