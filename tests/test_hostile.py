@@ -372,6 +372,11 @@ BAD_CELLS: list[tuple[str, dict, tuple[str, ...]]] = [
     ("warning-field-inside", {"cell": _warning_field(0.5)}, ("devices", "warning.polygon must contain")),
     ("warning-field-apart", {"cell": _warning_field(1.0, dx=20.0)}, ("devices", "warning.polygon must contain")),
     ("warning-field-overlapping", {"cell": _warning_field(1.0, dx=0.3)}, ("devices", "warning.polygon must contain")),
+    ("scanner-resolution-nan", {"cell": _device("laser-scanner", resolution_mm=float("nan"))},
+     ("devices", "resolution_mm")),
+    ("scanner-resolution-negative", {"cell": _device("laser-scanner", resolution_mm=-70.0)},
+     ("devices", "resolution_mm")),
+    ("scanner-resolution-huge", {"cell": _device("laser-scanner", resolution_mm=1e300)}, ("devices", "resolution_mm")),
 ]
 
 
