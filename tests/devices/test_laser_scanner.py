@@ -32,7 +32,7 @@ def test_scanner_intrusion_allowance_is_at_least_850():
 def test_primitive_and_description():
     s = scanner(height=0.25)
     assert s.primitives() == (ScanPlane(FIELD, 0.25),)
-    assert s.describe() == "4-point field at 0.25 m"
+    assert s.describe() == "4-point field at 0.25 m, 70 mm"
 
 
 def test_field_must_be_a_simple_polygon():

@@ -94,8 +94,6 @@ def plan_result(tmp_path_factory) -> dict:
     ("hazard.episode", 40, "hazard.episode"),
     ("seed", 7, "the search run again (searcher plan, seed 7"),
     ("found", False, "found"),
-    ("episodes", 39, "episodes"),
-    ("risk_per_episode", [0.5], "risk_per_episode"),
 ])
 def test_replay_recomputes_every_claim(plan_result, tmp_path, capsys, field, value, named) -> None:
     """A forged value anywhere in the file is a MISMATCH that names it, never 'REPRODUCED'."""
@@ -112,6 +110,19 @@ def test_replay_recomputes_every_claim(plan_result, tmp_path, capsys, field, val
     assert "REPRODUCED" not in out
     mismatches = [line for line in out.splitlines() if line.startswith("MISMATCH: ")]
     assert mismatches and named in mismatches[0], out
+
+
+@pytest.mark.parametrize(("field", "value"), [("episodes", 39), ("risk_per_episode", [0.5])])
+def test_replay_refuses_a_file_that_disagrees_with_itself(plan_result, tmp_path, capsys, field, value) -> None:
+    """A file whose lists do not match the episodes it claims is not a result at all (issue 29): exit 2, one line
+    naming the file and the list, before anything is replayed."""
+    doc = json.loads(json.dumps(plan_result))
+    assert doc[field] != value
+    doc[field] = value
+    (tmp_path / "result.json").write_text(json.dumps(doc))
+    code, out, err = _run(["replay", str(tmp_path / "result.json")], capsys)
+    assert code == 2 and "REPRODUCED" not in out
+    assert err.count("\n") == 1 and "result.json" in err and "risk_per_episode" in err, err
 
 
 def test_replay_of_a_file_from_before_the_criterion_and_sequence_count(plan_result, tmp_path, capsys) -> None:

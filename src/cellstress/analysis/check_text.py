@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from cellstress.analysis.hazard_zone import Closest
-from cellstress.core.iso13857 import MIN_HIGH_RISK_STRUCTURE_MM
+from cellstress.core.iso13857 import MIN_HIGH_RISK_STRUCTURE_MM, WHOLE_BODY_SLOT_MM, WHOLE_BODY_SQUARE_ROUND_MM
 
 LOW_HIGH_RISK = MIN_HIGH_RISK_STRUCTURE_MM / 1000.0  # m
 
@@ -57,6 +57,13 @@ def check_lines(r) -> list[str]:
     for p in r.fences:
         if not p.closed:
             out.append(f"  {p.name} {_xy(p.start)}-{_xy(p.end)} counts as open: {p.reason}")
+    if r.openings:
+        out.append(f"openings in the perimeter (ISO 13857 whole body: a slot wider than {WHOLE_BODY_SLOT_MM:.0f} mm, a "
+                   f"square or round opening wider than {WHOLE_BODY_SQUARE_ROUND_MM:.0f} mm, unless a device sees it):")
+        out += [f"  {o.line()}" for o in r.openings]
+    if r.access:
+        out.append("getting over, under or across the devices (ISO 13855):")
+        out += [f"  {a.line()}" for a in r.access]
     for a in (r.approach, *r.robot_approaches):
         out += _approach_lines(a, cycles.get(a.robot, z.cycle))
     for rc in r.restarts:

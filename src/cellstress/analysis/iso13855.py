@@ -25,6 +25,9 @@ The reasoning behind every number is in docs/cells.md. In short:
   4.2.2), one raised off the floor lets the arm under it (ISO 13857's tables for reaching under, Tables 6 and
   7, are for the lower limbs and not in ``core.iso13857``), and one that does not meet Table 2 lets it over:
   these three count as open in the undetected reach.
+* **Ways in** (issue 34): openings in the perimeter the whole body passes unseen (ISO 13857's 180 / 240 mm,
+  ``analysis.openings``); reaching over a light curtain (ISO 13855 C_RO), crawling under or stepping over it, a
+  scanner's mounting height against its resolution, a mat's depth (``analysis.espe_rules``).
 """
 
 from __future__ import annotations
@@ -34,10 +37,14 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+from scipy import ndimage
 
 from cellstress.analysis.check_text import check_lines
+from cellstress.analysis.espe_rules import curtain_reach_over, device_rules, entry_covers, failure_name
+from cellstress.analysis.floor_fill import GRID, detection_margin, floor_fill
 from cellstress.analysis.hazard_zone import Closest, HazardZone, closest_on_zone, hazard_zone, segment_to_zone
 from cellstress.analysis.muting import muting_checks
+from cellstress.analysis.openings import perimeter_openings
 from cellstress.analysis.plane import (
     closest_reach,
     detour_nodes,
@@ -55,13 +62,12 @@ from cellstress.cell.load import Cell, load_cell
 from cellstress.core.iso13857 import NO_BARRIER_BELOW_MM
 from cellstress.core.records import DoorLeaf, ScanPlane, VerticalField
 from cellstress.devices.base import DeviceRecord, stops_robot
-from cellstress.human.body import WALK_BLOCK_HEIGHT
+from cellstress.devices.light_curtain import LightCurtain
 from cellstress.robot.stopping import RobotStop
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 from cellstress.sim.build import build_layout
 
-GRID = 0.05  # m, flood-fill grid
 ARM_ALLOWANCE = 0.85  # m, ISO 13857 reach of the arm up to the armpit (also ISO 13855's C for body detection)
 LOW_FENCE = NO_BARRIER_BELOW_MM / 1000.0  # m, ISO 13857 4.2.2: a structure lower than this is no barrier
 
@@ -161,6 +167,8 @@ class StaticCheck:
     robot_cycles: tuple[tuple[str, float], ...] = ()  # several robots: each one's cycle time [s]
     mutings: tuple = ()  # analysis.muting.MutingCheck of every muted light curtain
     speeds: tuple = ()  # analysis.stopping.SpeedCheck: each configured device speed against the robot's real one
+    openings: tuple = ()  # analysis.openings.Opening: every opening in the perimeter, against the whole body
+    access: tuple = ()  # analysis.espe_rules records: getting over, under or across the devices (ISO 13855)
 
     @property
     def ok(self) -> bool:
@@ -169,7 +177,10 @@ class StaticCheck:
     def failures(self) -> list[str]:
         """Names of the failed checks: device names, 'undetected-reach', 'reach-over' (ISO 13857 Table 2),
         'DEVICE-restart', 'DEVICE-muting', 'DEVICE-speed' (a configured speed below the robot's real one; in a
-        cell of several robots, with ':ROBOT' after a device's or the reach checks' names)."""
+        cell of several robots, with ':ROBOT' after a device's or the reach checks' names), 'whole-body-opening'
+        (an opening in the perimeter the body passes unseen), 'DEVICE-reach-over' (over a curtain's top, with
+        ':ROBOT' in a cell of several), 'DEVICE-crawl-under', 'DEVICE-step-over', 'DEVICE-mounting' (a scanner
+        lower than its resolution allows), 'DEVICE-depth' (a mat that can be stepped across)."""
         out = [d.device + (f":{d.robot}" if d.robot else "") for d in self.devices if not d.ok]
         for a in (self.approach, *self.robot_approaches):
             if not a.ok:
@@ -179,6 +190,9 @@ class StaticCheck:
         out += [f"{r.device}-restart" for r in self.restarts if not r.ok]
         out += [f"{m.device}-muting" for m in self.mutings if not m.ok]
         out += [f"{s.device}-speed" for s in self.speeds if not s.ok]
+        if any(not o.ok for o in self.openings):
+            out.append("whole-body-opening")
+        out += [name for rule in self.access for name in failure_name(rule)]
         return out
 
     def lines(self) -> list[str]:
@@ -186,28 +200,6 @@ class StaticCheck:
 
 
 # ---- the cell's parts -------------------------------------------------------------------------------------
-
-
-def _upright_capsule_bands(body: np.ndarray) -> list[tuple[float, float, float]]:
-    """(z low, z high, radius) of the upright worker's body capsules (kernels.human_pose at zero flexion)."""
-    hip = body[L.B_HIP_Z]
-    shoulder = hip + body[L.B_SHOULDER_RISE]
-    arm_low = max(shoulder - (body[L.B_ARM_LEN] - body[L.B_R_ARM]), body[L.B_R_ARM])
-    head = hip + body[L.B_HEAD_RISE]
-    rl, rt, rh, ra = body[L.B_R_LEG], body[L.B_R_TRUNK], body[L.B_R_HEAD], body[L.B_R_ARM]
-    return [(0.0, hip + rl, rl), (hip - rt, hip + body[L.B_TRUNK_TOP] + rt, rt),
-            (head - rh, head + rh, rh), (arm_low - ra, shoulder + ra, ra)]
-
-
-def detection_margin(body: np.ndarray, lo: float, hi: float) -> float:
-    """How close (plan view) the worker's centre may come to a detection zone spanning heights lo..hi unseen.
-
-    Facing the zone, every body capsule's axis lies on the line through the centre parallel to the zone's
-    edge (legs and arms are side by side), so the worker stays unseen while the centre is farther than the
-    largest radius among the capsules that reach into the height band.
-    """
-    radii = [r for (zl, zh, r) in _upright_capsule_bands(body) if zl <= hi and zh >= lo]
-    return max(radii) if radii else 0.0
 
 
 def lean_reach(layout) -> float:
@@ -225,11 +217,6 @@ def lean_reach(layout) -> float:
     return best
 
 
-def _walk_blocking_fences(spec):
-    return [(a, b) for f in spec.fences if f.bottom < WALK_BLOCK_HEIGHT
-            for a, b in zip(f.points, f.points[1:], strict=False)]
-
-
 # ---- the checks -------------------------------------------------------------------------------------------
 def episode_length(spec) -> float:
     sim = spec.simulation
@@ -243,13 +230,7 @@ def _device_checks(spec, zone: HazardZone, robot_stop: RobotStop, robot: str = "
     stop = robot_stop.to_standstill
     delay, braking = robot_stop.delay, robot_stop.braking
     t_ep = episode_length(spec)
-    fl = spec.floor
-    floor_edges = [((fl.xmin, fl.ymin), (fl.xmax, fl.ymin)), ((fl.xmax, fl.ymin), (fl.xmax, fl.ymax)),
-                   ((fl.xmax, fl.ymax), (fl.xmin, fl.ymax)), ((fl.xmin, fl.ymax), (fl.xmin, fl.ymin))]
-    covers = list(_walk_blocking_fences(spec)) + floor_edges
-    for ob in spec.solid_obstacles():  # the worker cannot walk into an obstacle: its edges are no way in
-        poly = ob.footprint()
-        covers += [(poly[i], poly[(i + 1) % len(poly)]) for i in range(len(poly))]
+    covers = entry_covers(spec)
     out = []
     for d in spec.devices:
         iso = d.stop_distance(delay, braking) if isinstance(d, DeviceRecord) else d.required_distance(stop)
@@ -327,46 +308,15 @@ def _approach_check(spec, layout, zone: HazardZone, vol: HazardVolume, panels, l
     """The undetected reach from the start point; with ``behind`` (a device's detection primitive), from every
     floor region next to that zone instead: where a worker who crossed it stands once it no longer sees them
     (what an automatic restart lets the robot meet)."""
-    from scipy import ndimage
-
     body = layout.params.body
     radius = float(body[L.B_BODY_RADIUS])
     fl = spec.floor
     h = GRID
-    nx = int(round((fl.xmax - fl.xmin) / h))
-    ny = int(round((fl.ymax - fl.ymin) / h))
-    xs = fl.xmin + (np.arange(nx) + 0.5) * h
-    ys = fl.ymin + (np.arange(ny) + 0.5) * h
-    X, Y = np.meshgrid(xs, ys)  # (ny, nx)
-    ok = (X - radius >= fl.xmin) & (X + radius <= fl.xmax) & (Y - radius >= fl.ymin) & (Y + radius <= fl.ymax)
-    for ob in spec.solid_obstacles():  # (the robot's pedestal stands inside the hazard zone: no matter)
-        poly = ob.footprint()
-        ok &= ~points_in_polygon(X, Y, poly) & (distance_to_polyline(X, Y, poly, True) >= radius)
-    for a, b in _walk_blocking_fences(spec):
-        ok &= point_segment(X, Y, a[0], a[1], b[0], b[1])[0] >= radius
-    m_scan: float | None = None
-    m_curtain: float | None = None
-    curtains = []
-    for prim in (p for d in spec.devices for p in d.primitives()):
-        if isinstance(prim, ScanPlane):
-            m = detection_margin(body, prim.height, prim.height)
-            m_scan = m if m_scan is None else max(m_scan, m)
-            ok &= ~points_in_polygon(X, Y, prim.polygon) & (distance_to_polyline(X, Y, prim.polygon, True) > m)
-        else:
-            m = detection_margin(body, prim.bottom, prim.top)
-            m_curtain = m if m_curtain is None else max(m_curtain, m)
-            ok &= point_segment(X, Y, prim.start[0], prim.start[1], prim.end[0], prim.end[1])[0] > m
-            curtains.append((tuple(prim.start), tuple(prim.end)))
+    ff = floor_fill(spec, body)
+    X, Y, xs, ys, labels, U, detected = ff.X, ff.Y, ff.xs, ff.ys, ff.labels, ff.U, ff.detected
+    ok, m_scan, m_curtain, curtains = ff.ok, ff.m_scan, ff.m_curtain, list(ff.curtains)
+    ny, nx = ok.shape
     sx, sy = spec.human.start.xy
-    ix = min(max(int((sx - fl.xmin) / h), 0), nx - 1)
-    iy = min(max(int((sy - fl.ymin) / h), 0), ny - 1)
-    labels, _ = ndimage.label(ok)
-    seed = labels[iy, ix]
-    if seed == 0:  # the start cell's centre is a little off the start point: try the neighbours
-        near = labels[max(iy - 1, 0):iy + 2, max(ix - 1, 0):ix + 2]
-        seed = int(near.max())
-    detected = seed == 0
-    U = (labels == seed) if not detected else np.zeros_like(ok)
     if behind is not None:  # every region that touches the zone's margin (plus two grid cells): either side
         if isinstance(behind, ScanPlane):
             reach = detection_margin(body, behind.height, behind.height) + 2 * h
@@ -464,7 +414,26 @@ def check_cell(cell: Cell | str | Path, layout=None) -> StaticCheck:
                        episode_length(spec), spec.human.arrival == "fixed",
                        _restart_checks(spec, layout, zone, vol, panels, lean), more,
                        tuple((p.name, float(p.trajectory.cycle)) for p in layout.robots) if more else (),
-                       muting_checks(spec), speed_checks(layout))
+                       muting_checks(spec), speed_checks(layout),
+                       perimeter_openings(spec, floor_fill(spec, body), float(body[L.B_BODY_RADIUS])),
+                       _access_rules(spec, layout, devices, vol))
+
+
+def _access_rules(spec, layout, devices, vol: HazardVolume) -> tuple:
+    """Reach over every light curtain's top (for each robot it stops, with that robot's T and hazard zone), then
+    the rules of ``espe_rules.device_rules``."""
+    by_name = {d.name: d for d in spec.devices}
+    names = [r.name for r in spec.robots]
+    vols: dict[str, HazardVolume] = {}
+    out = []
+    for row in devices:
+        dev = by_name.get(row.device)
+        if not isinstance(dev, LightCurtain) or row.type != dev.type:
+            continue
+        if row.robot and row.robot not in vols:
+            vols[row.robot] = hazard_volume(layout, robot=names.index(row.robot))
+        out.append(curtain_reach_over(dev, vols.get(row.robot, vol), row.T, row.required, row.robot))
+    return tuple(out) + device_rules(spec)
 
 
 def _per_robot(spec, layout, lean: float) -> tuple[tuple[DeviceCheck, ...], list[ApproachCheck]]:

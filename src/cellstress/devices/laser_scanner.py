@@ -19,7 +19,7 @@ from typing import Annotated, ClassVar, Literal
 from pydantic import Field, model_validator
 
 from cellstress.core.fields import Polygon, PositiveTime, Record
-from cellstress.core.iso13855 import K_WALK, MIN_C_BODY, mm
+from cellstress.core.iso13855 import K_WALK, horizontal_c_mm, mm
 from cellstress.core.plane import polygon_outside_point
 from cellstress.core.records import Channel, IsoDistance, ScanPlane
 from cellstress.devices.base import DeviceRecord, Restart
@@ -42,7 +42,7 @@ class WarningField(Record):
 
 
 def _c(height_mm: float) -> float:
-    return max(MIN_C_BODY, 1200.0 - 0.4 * height_mm)
+    return horizontal_c_mm(height_mm)
 
 
 class LaserScanner(DeviceRecord):
@@ -57,6 +57,10 @@ class LaserScanner(DeviceRecord):
     """Height of the scan plane above the floor [m]; it sees what crosses the plane inside the field."""
     response_time: PositiveTime = 0.35
     """Time [s] from detection to the stop signal."""
+    resolution_mm: Annotated[float, Field(ge=10.0, le=200.0, allow_inf_nan=False)] = 70.0
+    """Detection capability d [mm] of the field (ISO 13855: the scan plane must lie at least 15 (d - 50) mm above
+    the floor, which ``check`` tests). Absent: 70 mm, the usual setting for detecting a person's legs, whose
+    lowest plane is 300 mm."""
     warning: WarningField | None = None
     """An optional warning field (same height and response time) that reduces the robot's speed."""
 
@@ -130,7 +134,7 @@ class LaserScanner(DeviceRecord):
                            f"(1 - {r:g})*{braking:g}) = {mm(s)} mm")
 
     def describe(self) -> str:
-        text = f"{len(self.polygon)}-point field at {self.height:g} m"
+        text = f"{len(self.polygon)}-point field at {self.height:g} m, {self.resolution_mm:g} mm"
         if self.warning is not None:
             text += f", warning field ({len(self.warning.polygon)} points) to {self.warning.reduced_speed:g} speed"
         return text + ("" if self.restart == "manual" else f", automatic restart after {self.clear_time:g} s")
