@@ -159,7 +159,7 @@ class ForceVerdict:
                 "limit_N": self.limit, "ratio": self.ratio, "unsafe": self.unsafe, "reason": self.reason,
                 "case": self.case, "v_human": self.v_human, "why_case": self.why_case(),
                 "surface": None if b is None else b.surface, "gap_m": None if b is None else b.gap,
-                "travel_m": None if b is None else b.travel}
+                "travel_m": b.travel if self.case == "clamping" else None}
 
 
 class Iso15066(CriterionRecord):
@@ -204,9 +204,10 @@ class Iso15066(CriterionRecord):
         _, k, m_h = REGIONS[contact.region]
         k = k * 1000.0
         moving = bool(contact.v_r > self.speed_tolerance)
-        # the worker's speed towards the robot counts while the robot moves: meeting a robot at a standstill is
-        # meeting a fixed machine part, not the robot's power and force
-        v_human = min(HUMAN_SPEED_CAP, float(getattr(contact, "v_human", 0.0))) if moving else 0.0
+        # the worker's speed towards the robot counts while the robot moves faster than it creeps: below
+        # CREEP_SPEED the robot's own motion brings no region but the head over its limit, and the worker meets
+        # a robot that practically stands, as they would a machine part (docs/criteria.md)
+        v_human = min(HUMAN_SPEED_CAP, float(getattr(contact, "v_human", 0.0))) if contact.v_r > CREEP_SPEED else 0.0
         v_rel = contact.v_rel + v_human
         force = peak_force(v_rel, m_r, m_h, k)
         backing = getattr(contact, "backing", None)

@@ -30,88 +30,120 @@ from cellstress.sim import layout as L
 from cellstress.sim.build import Layout
 
 CAST_RANGE = 0.5  # m: the farthest a backing surface is looked for (a clamping gap is centimetres)
-TRAVEL_SAMPLES = 32  # path times sampled over the remaining motion (the largest advance of the point is kept)
+AXIS_SAMPLES = 9  # points along each robot capsule's axis where a hand in a reach volume may be pinned
+TRAVEL_SAMPLES = 16  # path times sampled over the remaining motion (the largest advance of the point is kept)
+# The robot's travel is measured only behind a gap this small (no criterion calls a wider gap clamping: iso15066's
+# is 20 mm); behind a wider one it is reported as 0 (the contact is free, the travel plays no part).
+TRAVEL_GAP = 0.1  # m
 _EPS = 1e-12
 
 
-def _inside(x: float, y: float, foot: np.ndarray) -> bool:
-    """Crossing-number point-in-polygon test."""
-    inside = False
-    n = len(foot)
-    for i in range(n):
-        (xi, yi), (xj, yj) = foot[i], foot[i - 1]
-        if (yi > y) != (yj > y) and x < xi + (y - yi) * (xj - xi) / (yj - yi):
-            inside = not inside
-    return inside
-
-
-def _ray_segment_2d(o: np.ndarray, d: np.ndarray, p0, p1) -> float | None:
-    """Ray parameter t >= 0 where o + t d (3-D, unit d) crosses the vertical plane of floor segment p0-p1 within
-    the segment, or None (parallel or missed)."""
-    ex, ey = p1[0] - p0[0], p1[1] - p0[1]
-    den = d[0] * ey - d[1] * ex
-    if abs(den) <= _EPS:
-        return None
-    wx, wy = p0[0] - o[0], p0[1] - o[1]
+def _cross_2d(o: np.ndarray, d: np.ndarray, p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
+    """(m, e): ray parameter t >= 0 where each ray o[i] + t d[i] (3-D, unit d) crosses the vertical plane of each
+    floor segment p0[j]-p1[j] within the segment; inf where parallel or missed."""
+    ex, ey = (p1[:, 0] - p0[:, 0])[None, :], (p1[:, 1] - p0[:, 1])[None, :]
+    dx, dy = d[:, 0:1], d[:, 1:2]
+    den = dx * ey - dy * ex
+    ok = np.abs(den) > _EPS
+    den = np.where(ok, den, 1.0)
+    wx, wy = p0[None, :, 0] - o[:, 0:1], p0[None, :, 1] - o[:, 1:2]
     t = (wx * ey - wy * ex) / den
-    u = (wx * d[1] - wy * d[0]) / den
-    return t if t >= 0.0 and -1e-9 <= u <= 1.0 + 1e-9 else None
-
-
-def ray_prism(o: np.ndarray, d: np.ndarray, foot: np.ndarray, height: float) -> float:
-    """Distance along the ray o + t d to a prism (footprint ``foot``, floor to ``height``): 0 inside, inf missed."""
-    if 0.0 <= o[2] <= height and _inside(o[0], o[1], foot):
-        return 0.0
-    best = math.inf
-    if d[2] < -_EPS and o[2] > height:  # the top face
-        t = (height - o[2]) / d[2]
-        if _inside(o[0] + t * d[0], o[1] + t * d[1], foot):
-            best = t
-    for i in range(len(foot)):  # the side faces
-        t = _ray_segment_2d(o, d, foot[i - 1], foot[i])
-        if t is not None and t < best and 0.0 <= o[2] + t * d[2] <= height:
-            best = t
-    return best
-
-
-def ray_panel(o: np.ndarray, d: np.ndarray, rect) -> float:
-    """Distance along the ray to a vertical panel x0 y0 x1 y1 bottom top (the kernel's fence row), inf missed."""
-    t = _ray_segment_2d(o, d, rect[0:2], rect[2:4])
-    if t is None or not rect[4] <= o[2] + t * d[2] <= rect[5]:
-        return math.inf
-    return t
-
-
-def ray_floor(o: np.ndarray, d: np.ndarray) -> float:
-    if o[2] <= 0.0:
-        return 0.0
-    return -o[2] / d[2] if d[2] < -_EPS else math.inf
+    u = (wx * dy - wy * dx) / den
+    return np.where(ok & (t >= 0.0) & (u >= -1e-9) & (u <= 1.0 + 1e-9), t, math.inf)
 
 
 class FixedSurfaces:
-    """The cell's fixed surfaces as the simulator has them (see the module docstring), named for reports."""
+    """The cell's fixed surfaces as the simulator has them (see the module docstring), named for reports. Every
+    prism side and every panel is a vertical rectangle over a floor segment; the rays are cast against all of them
+    at once (numpy), the prisms' top faces and insides by a crossing-number test per prism."""
 
     def __init__(self, layout: Layout):
-        self.prisms = tuple((o.name, np.asarray(o.footprint(), dtype=float), float(o.height))
-                            for o in layout.obstacles)
         P = layout.params
         doors, pallets = {int(f) for f in P.door_fence}, {int(f) for f in P.panel_fence}
         kinds = ["door" if i in doors else "pallet" if i in pallets else "fence" for i in range(len(P.fences))]
-        self.panels = tuple((f"{k} panel {kinds[:i + 1].count(k)}", np.asarray(row, dtype=float))
-                            for i, (k, row) in enumerate(zip(kinds, P.fences, strict=True)))
+        prisms = [(o.name, np.asarray(o.footprint(), dtype=float), float(o.height)) for o in layout.obstacles]
+        self.names = ("floor", *(name for name, _, _ in prisms),
+                      *(f"{k} panel {kinds[:i + 1].count(k)}" for i, k in enumerate(kinds)))
+        n_prisms = len(prisms)
+        starts, ends, lo, hi, owner = [], [], [], [], []
+        for p, (_, foot, h) in enumerate(prisms):
+            for i in range(len(foot)):
+                starts.append(foot[i - 1])
+                ends.append(foot[i])
+                lo.append(0.0)
+                hi.append(h)
+                owner.append(1 + p)
+        for i, row in enumerate(np.asarray(P.fences, dtype=float).reshape(-1, 6)):
+            starts.append(row[0:2])
+            ends.append(row[2:4])
+            lo.append(row[4])
+            hi.append(row[5])
+            owner.append(1 + n_prisms + i)
+        self.p0 = np.asarray(starts, dtype=float).reshape(-1, 2)
+        self.p1 = np.asarray(ends, dtype=float).reshape(-1, 2)
+        self.lo, self.hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+        self.owner = np.asarray(owner, dtype=np.int64)
+        self.heights = np.asarray([h for _, _, h in prisms], dtype=float)
+        # (prism edges, prisms): which prism each of the first edges bounds, for the crossing-number parity
+        n_edges = sum(len(f) for _, f, _ in prisms)
+        self.of_prism = np.zeros((n_edges, n_prisms))
+        self.of_prism[np.arange(n_edges), self.owner[:n_edges] - 1] = 1.0
+
+    def _inside(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """(m, prisms): is point (x[i, p], y[i, p]) inside prism p's footprint (crossing number)."""
+        n = self.of_prism.shape[0]
+        if not n:
+            return np.zeros(x.shape, dtype=bool)
+        cols = self.owner[:n] - 1
+        px, py = x[:, cols], y[:, cols]  # each edge against its own prism's point
+        (xi, yi), (xj, yj) = self.p1[:n].T, self.p0[:n].T
+        flat = yi == yj
+        dy = np.where(flat, 1.0, yj - yi)
+        crosses = ((yi > py) != (yj > py)) & (px < xi + (py - yi) * (xj - xi) / dy) & ~flat
+        return (crosses.astype(float) @ self.of_prism) % 2.0 == 1.0
+
+    def distances(self, origins, directions) -> np.ndarray:
+        """(m, surfaces): distance along each ray (origins, unit directions: (m, 3)) to each surface, in the
+        order of ``names`` (0 from inside a solid or below the floor; inf where missed)."""
+        o = np.asarray(origins, dtype=float).reshape(-1, 3)
+        d = np.asarray(directions, dtype=float).reshape(-1, 3)
+        m, n_prisms = len(o), len(self.heights)
+        out = np.full((m, len(self.names)), math.inf)
+        falling = d[:, 2] < -_EPS
+        out[:, 0] = np.where(o[:, 2] <= 0.0, 0.0, np.where(falling, -o[:, 2] / np.where(falling, d[:, 2], -1.0),
+                                                           math.inf))
+        # the sides of prisms and the panels: vertical rectangles
+        t = _cross_2d(o, d, self.p0, self.p1)
+        z = o[:, 2:3] + np.where(np.isfinite(t), t, 0.0) * d[:, 2:3]
+        t = np.where((z >= self.lo[None, :]) & (z <= self.hi[None, :]), t, math.inf)
+        for col in np.unique(self.owner):
+            out[:, col] = np.min(t[:, self.owner == col], axis=1)
+        if n_prisms:
+            h = self.heights[None, :]
+            down = falling[:, None] & (o[:, 2:3] > h)  # the top faces
+            tt = np.where(down, (h - o[:, 2:3]) / np.where(down, d[:, 2:3], -1.0), 0.0)
+            top = down & self._inside(o[:, 0:1] + tt * d[:, 0:1], o[:, 1:2] + tt * d[:, 1:2])
+            prisms = out[:, 1:1 + n_prisms]
+            prisms = np.where(top & (tt < prisms), tt, prisms)
+            within = (o[:, 2:3] >= 0.0) & (o[:, 2:3] <= h) & self._inside(
+                np.repeat(o[:, 0:1], n_prisms, axis=1), np.repeat(o[:, 1:2], n_prisms, axis=1))
+            out[:, 1:1 + n_prisms] = np.where(within, 0.0, prisms)
+        return out
 
     def nearest(self, origin, direction, reach: float = CAST_RANGE) -> tuple[str, float] | None:
         """(name, distance) of the first fixed surface on the ray from ``origin`` along the unit ``direction``
         within ``reach`` [m] (distance 0: the origin is inside a solid or below the floor), or None."""
-        o, d = np.asarray(origin, dtype=float), np.asarray(direction, dtype=float)
-        best: tuple[str, float] | None = None
-        hits = [("floor", ray_floor(o, d))]
-        hits += [(name, ray_prism(o, d, foot, h)) for name, foot, h in self.prisms]
-        hits += [(name, ray_panel(o, d, rect)) for name, rect in self.panels]
-        for name, t in hits:  # the first in this order wins a tie: deterministic
-            if t <= reach and (best is None or t < best[1]):
-                best = (name, float(t))
-        return best
+        which, dist = self.nearest_many(origin, direction, reach)
+        return None if which[0] < 0 else (self.names[int(which[0])], float(dist[0]))
+
+    def nearest_many(self, origins, directions, reach: float = CAST_RANGE) -> tuple[np.ndarray, np.ndarray]:
+        """For each ray: the index into ``names`` of its first surface within ``reach`` (-1: none; the first in
+        ``names``' order on a tie) and the distance (inf: none)."""
+        t = self.distances(origins, directions)
+        k = np.argmin(t, axis=1)
+        dist = t[np.arange(len(t)), k]
+        found = dist <= reach
+        return np.where(found, k, -1), np.where(found, dist, math.inf)
 
 
 def body_thickness(layout: Layout, part: int, pose: BodyPose) -> float:
@@ -204,3 +236,42 @@ def travel(layout: Layout, row: np.ndarray, joint: int, point, direction, v_push
         K.forward_kinematics(P, q, rot, pos)
         best = max(best, float(d @ (rot[joint] @ local + pos[joint] - start)))
     return best
+
+
+def robot_surface_points(layout: Layout, row: np.ndarray, work) -> tuple[np.ndarray, ...]:
+    """Where a hand that may be anywhere in the worker's reach volumes can be pinned by the robot: points on robot
+    0's capsules (``AXIS_SAMPLES`` along each axis, each moved out by the radius along its own direction of motion,
+    the capsule's leading side) inside the worker's envelope at the row's pose (``kernels.worker_point_distances``:
+    reach volumes, fences respected, and body capsules), with their unit direction of motion, speed [m/s] and kernel
+    joint. Capsules on the fixed base and points at rest are left out. (points, directions, speeds, joints)."""
+    P = layout.params
+    n_caps = P.cap_joint.shape[0]
+    nj = P.placements.shape[0]
+    tau, h = float(row[L.M_TAU]), 1e-6
+    sigma = time_scaling(layout, row)
+    q, qd = np.zeros(nj), np.zeros(nj)
+    rot, pos = np.zeros((nj, 3, 3)), np.zeros((nj, 3))
+    ends = []
+    for t in (tau, tau + h):
+        K.joint_trajectory(P, t, 1.0, q, qd)
+        K.forward_kinematics(P, q, rot, pos)
+        ra, rb = np.zeros((n_caps, 3)), np.zeros((n_caps, 3))
+        K.robot_capsules(P, rot, pos, ra, rb)
+        ends.append((ra, rb))
+    (a0, b0), (a1, b1) = ends
+    s = np.linspace(0.0, 1.0, AXIS_SAMPLES)[None, :, None]
+    p0 = a0[:, None, :] + s * (b0 - a0)[:, None, :]
+    vel = sigma * (a1[:, None, :] + s * (b1 - a1)[:, None, :] - p0) / h
+    speed = np.linalg.norm(vel, axis=2)
+    keep = (speed > 1e-6) & (P.cap_joint[:, None] >= 0)
+    dirs = np.where(keep[..., None], vel / np.where(keep, speed, 1.0)[..., None], 0.0)
+    lead = p0 + np.asarray(P.cap_r, dtype=float)[:, None, None] * dirs
+    caps = np.broadcast_to(np.arange(n_caps)[:, None], keep.shape)
+    lead, dirs, speed, caps = lead[keep], dirs[keep], speed[keep], caps[keep]
+    if not len(lead):
+        return lead, dirs, speed, np.zeros(0, dtype=np.int64)
+    dist = np.empty((1, len(lead)))
+    K.worker_point_distances(P, work, np.ascontiguousarray(L.row_pose(row)[None, :]),
+                             np.ascontiguousarray(lead[None, :, :]), dist)
+    inside = dist[0] <= 0.0
+    return lead[inside], dirs[inside], speed[inside], P.cap_joint[caps[inside]].astype(np.int64)

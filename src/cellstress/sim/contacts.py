@@ -22,6 +22,7 @@ from cellstress.human.regions import body_region
 from cellstress.robot.dynamics import point_dynamics, reflected_mass
 from cellstress.robot.model import load_pinocchio
 from cellstress.sim import clamping, scene
+from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 from cellstress.sim.build import Layout
 
@@ -45,6 +46,7 @@ class ContactModel:
         jm = layout.joints
         self.reduce = None if len(jm.driven) == layout.robot.n_joints else jm.jacobian_map()
         self.surfaces = clamping.FixedSurfaces(layout)
+        self._work = K.make_work(P)  # the worker-only kernels' scratch (clamping.robot_surface_points)
 
     def contact(self, row: np.ndarray, before: np.ndarray | None = None) -> ContactInCell:
         """The closest points of a metric row, with the region, normal, v_rel and reflected mass there, and its
@@ -85,18 +87,56 @@ class ContactModel:
 
     def _backing(self, row, part, rp, hp, n, pose, j, v_point, mass) -> Backing | None:
         """The nearest fixed surface behind the body region along the push direction: the contact normal for a
-        body capsule; for a reach volume (a hand anywhere in it) the robot point's own direction of motion."""
+        body capsule; for a reach volume (a hand anywhere in it) the robot point's own direction of motion, and
+        the robot surface point anywhere in the worker's envelope that pins a hand with the least gap."""
+        thick = clamping.body_thickness(self.layout, part, pose)
         d = n
         speed = float(np.linalg.norm(v_point))
-        if part in (L.PART_LEFT_REACH, L.PART_RIGHT_REACH) and speed > 1e-9:
-            d = v_point / speed
+        if part in (L.PART_LEFT_REACH, L.PART_RIGHT_REACH):
+            if speed > 1e-9:
+                d = v_point / speed
+            pinned = self._pinning_point(row, thick)
+            here = self.surfaces.nearest(hp, d)
+            if pinned is not None and (here is None or pinned[0][1] < here[1]):
+                (name, dist), point, d, v_push, jp = pinned
+                jm = self._mass_along(jp, point, row, d)
+                return Backing(name, dist, thick, _p3(d), v_push, jm,
+                               self._travel(row, jp, point, d, v_push, dist - thick))
         hit = self.surfaces.nearest(hp, d)
         if hit is None:
             return None
         v_push = max(0.0, float(d @ v_point))
-        return Backing(hit[0], hit[1], clamping.body_thickness(self.layout, part, pose), _p3(d), v_push,
-                       math.inf if mass is None else mass(d),
-                       clamping.travel(self.layout, row, j, rp, d, v_push))
+        return Backing(hit[0], hit[1], thick, _p3(d), v_push, math.inf if mass is None else mass(d),
+                       self._travel(row, j, rp, d, v_push, hit[1] - thick))
+
+    def _travel(self, row, joint: int, point, d, v_push: float, gap: float) -> float:
+        """The robot point's travel along ``d`` until standstill, behind a gap of at most TRAVEL_GAP; else 0."""
+        if gap > clamping.TRAVEL_GAP:
+            return 0.0
+        return clamping.travel(self.layout, row, joint, point, d, v_push)
+
+    def _pinning_point(self, row, thickness: float):
+        """((surface, distance), point, direction, speed, joint) of the robot surface point inside the worker's
+        envelope with the nearest fixed surface ahead of it (the least gap; the first such point on a tie), or
+        None (``clamping.robot_surface_points``)."""
+        points, dirs, speeds, joints = clamping.robot_surface_points(self.layout, row, self._work)
+        if not len(points):
+            return None
+        which, dist = self.surfaces.nearest_many(points, dirs)
+        i = int(np.argmin(dist))  # the first on a tie
+        if which[i] < 0:
+            return None
+        return ((self.surfaces.names[int(which[i])], float(dist[i])), points[i], dirs[i], float(speeds[i]),
+                int(joints[i]))
+
+    def _mass_along(self, joint: int, point: np.ndarray, row, d: np.ndarray) -> float:
+        """The robot's reflected mass [kg] at ``point`` on kernel joint ``joint`` along ``d`` (no payload)."""
+        q, _ = scene.joint_state(self.layout, row)
+        pb = self.R_base.T @ (point - self.t_base)
+        Jp, M = point_dynamics(self.model, self.data, self.layout.robot.pinocchio_q(q), joint + 1, pb)
+        if self.reduce is not None:
+            Jp, M = Jp @ self.reduce, self.reduce.T @ M @ self.reduce
+        return reflected_mass(Jp, M, self.R_base.T @ d)
 
 
 def _p3(v) -> tuple[float, float, float]:
