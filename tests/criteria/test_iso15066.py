@@ -111,7 +111,9 @@ def test_hand_contact_at_low_speed_is_safe_under_iso_but_not_under_the_paper():
     assert 0.0 < alone.force < alone.limit == 280.0 and not alone.unsafe
     # with the worker's own speed (the hand swung towards the robot as the trunk bends, 1.3 m/s) it is unsafe
     v = iso.verdict_at(trace, touching[0])
-    assert v.unsafe and v.v_human > 1.0 and v.force > 280.0 and v.reason.endswith("transient limit (hands)")
+    assert v.unsafe and v.v_human > 1.0 and v.force > 280.0 and v.case == "transient"
+    assert v.reason.startswith(f"{v.force:.0f} N > 280 N transient limit (hands): no fixed surface behind the body")
+    assert v.reason.endswith(f"v_rel {v.v_rel:.2f} m/s with the worker's {v.v_human:.2f} m/s towards the robot")
 
 
 def test_head_contact_while_moving_is_unsafe_at_any_force():

@@ -12,10 +12,10 @@ Transient: F = v_rel * sqrt(mu * k) (ISO/TS 15066 Annex A, eq. A.6 rearranged fo
 mu = (1/m_H + 1/m_R)^-1, the region's effective mass m_H and spring constant k (Table A.3), the robot's
 effective mass m_R at the contact point along the contact normal n (the reflected mass the simulator computes
 with pinocchio, ``robot.dynamics``, plus the payload), and v_rel the speed of the robot's contact point towards
-the human along n plus, while the robot moves, the worker's own speed towards the robot along n (capped at
-``HUMAN_SPEED_CAP``). Clamping: the body region cannot recoil, so the robot's whole effective mass is felt, and the
-robot keeps pushing until it stands: F = max(transient F, v_push sqrt(m_R k), k * travel). Derivations and every
-number's source: docs/criteria.md.
+the human along n plus, while the robot moves faster than ``CREEP_SPEED``, the worker's own speed towards the robot
+along n (capped at ``HUMAN_SPEED_CAP``). Clamping: the body region cannot recoil, so the robot's whole effective
+mass is felt, and the robot keeps pushing until it stands: F = max(transient F, v_push sqrt(m_R k), k * travel).
+Derivations and every number's source: docs/criteria.md.
 
 The simulator has no fast path for this criterion: it hands every contact to ``judge`` (``core.records.Contact``:
 body region, normal, v_rel and reflected mass at the closest points), and the force ratio at every action end to
@@ -173,8 +173,9 @@ class Iso15066(CriterionRecord):
     def describe(self) -> str:
         return ("unsafe when a contact's estimated peak force exceeds the ISO/TS 15066 limit of the body region "
                 "touched (quasi-static when the region is clamped against a fixed surface within its thickness + "
-                f"{CLAMP_TOLERANCE * 1000:.0f} mm, transient otherwise; the worker's own speed towards the moving "
-                "robot counted, up to 2 m/s), or the head is touched while the robot moves (robot payload "
+                f"{CLAMP_TOLERANCE * 1000:.0f} mm, transient otherwise; the worker's own speed towards a robot faster "
+                f"than {CREEP_SPEED:.3f} m/s counted, up to {HUMAN_SPEED_CAP:g} m/s), or the head is touched while "
+                "the robot moves (robot payload "
                 f"{self.payload:g} kg; docs/criteria.md)")
 
     def rule(self, region: str, force: float, moving: bool, clamped: bool = False) -> tuple[bool, str | None]:
@@ -220,9 +221,10 @@ class Iso15066(CriterionRecord):
                                quasi_static_limit(contact.region) if clamped else transient_limit(contact.region),
                                touching, moving, unsafe, reason, "clamping" if clamped else "transient", v_human,
                                backing)
-        if reason is not None and clamped:
-            return replace(verdict, reason=f"{reason}: {verdict.why_case()}")
-        return verdict
+        if reason is None:
+            return verdict
+        worker = f"; v_rel {v_rel:.2f} m/s with the worker's {v_human:.2f} m/s towards the robot" if v_human else ""
+        return replace(verdict, reason=f"{reason}: {verdict.why_case()}{worker}")
 
     def judge(self, contact: Contact) -> ForceVerdict:
         return self.assess(contact)
