@@ -4,6 +4,7 @@ test cell cells/clamp-table.yaml, a slow UR5 picking parts from a table the work
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +14,7 @@ import cellstress
 from cellstress.cli import main
 from cellstress.core.records import Contact
 from cellstress.criteria.iso15066 import CREEP_SPEED, Iso15066
+from cellstress.report.scope import strongest_contact
 from cellstress.searchers.result import SearchResult
 from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
@@ -69,3 +71,18 @@ def test_replay_reproduces_the_clamping_hazard(found, tmp_path, capsys):
     path = found.write(tmp_path)
     assert main(["replay", str(path)]) == 0
     assert "REPRODUCED bit-exactly" in capsys.readouterr().out
+
+
+def test_a_search_that_finds_nothing_names_the_case_of_its_strongest_contact():
+    """What `search` prints when nothing is unsafe (report.scope.strongest_contact): force, limit, case, why."""
+    sim = Simulator(CELL)
+    for acts in np.random.default_rng(3).integers(0, sim.n_actions, (300, 8)).tolist():
+        trace = sim.run(acts)
+        if trace.unsafe or not np.any(trace.rows[:, L.M_D] <= 0.0):
+            continue
+        text = strongest_contact(sim, acts)
+        assert re.match(r"\d+ N against a \d+ N limit \((quasi-static|transient), (hands|forearms); "
+                        r"(clamped against the|free: the|no fixed surface)", text), text
+        break
+    else:
+        pytest.fail("no safe episode with a contact in 300")

@@ -30,6 +30,10 @@ from cellstress.sim import layout as L
 from cellstress.sim.build import Layout
 
 CAST_RANGE = 0.5  # m: the farthest a backing surface is looked for (a clamping gap is centimetres)
+# Surroundings are measured for closest points at most this far apart: the largest distance tolerance a criterion
+# may have (criteria.base.CriterionRecord). Farther apart (the reward's look at every action end) the contact has
+# no backing: the search's severity there is the free contact's.
+CONTACT_RANGE = 0.1  # m
 AXIS_SAMPLES = 9  # points along each robot capsule's axis where a hand in a reach volume may be pinned
 TRAVEL_SAMPLES = 16  # path times sampled over the remaining motion (the largest advance of the point is kept)
 # The robot's travel is measured only behind a gap this small (no criterion calls a wider gap clamping: iso15066's

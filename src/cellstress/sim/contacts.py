@@ -81,7 +81,9 @@ class ContactModel:
         if before is not None:
             v = clamping.body_point_velocity(part, hp, pose, scene.body_pose(lay, before), float(P.scal[L.C_DT]))
             v_human = max(0.0, -float(n @ v))
-        backing = self._backing(row, part, rp, hp, n, pose, j, v_point, mass)
+        backing = None  # apart (d_HR over any criterion's distance tolerance) nothing is clamped yet
+        if float(row[L.M_D]) <= clamping.CONTACT_RANGE:
+            backing = self._backing(row, part, rp, hp, n, pose, j, v_point, mass)
         return ContactInCell(float(row[L.M_D]), float(row[L.M_V]), lay.capsules[link].name, BODY_PARTS[part],
                              region, _p3(rp), _p3(hp), _p3(n), v_rel, m_r, v_human, backing)
 
