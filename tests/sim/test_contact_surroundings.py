@@ -138,3 +138,24 @@ def test_contacts_carry_the_worker_speed_and_the_verdict_is_the_judged_one():
     batch = sim.run_batch(np.asarray([[sim.action_index(a) for a in acts]]))
     assert int(batch.unsafe_step[0]) == int(row[L.M_STEP])
     assert sim.run(acts).rows.tobytes() == trace.rows.tobytes()  # the same inputs, the same bytes
+
+
+def test_a_trunk_pushed_against_a_fence_panel_is_backed_by_it():
+    """The body-capsule branch of ContactModel: the push direction is the contact normal, the thickness the
+    capsule's diameter (the trunk's), the surface the kernel's fence row straight behind the trunk."""
+    sim = Simulator(with_criterion(load_cell("baseline"), "iso15066"))
+    model, lay = sim.contacts, sim.layout
+    row = sim.initial_metrics()
+    fence = lay.params.fences[0]
+    a, b = fence[0:2], fence[2:4]
+    along = (b - a) / np.linalg.norm(b - a)
+    n = np.array([-along[1], along[0], 0.0])  # horizontal, across the panel
+    pose = scene.body_pose(lay, L.pose_vector(0.0, 0.0, 0.0))
+    thick = 2.0 * float(pose.r[2])
+    mid = np.array([*(a + b) / 2.0, 1.2])
+    for extra, clamped in ((0.01, True), (0.1, False)):
+        hp = mid - (thick + extra) * n  # the trunk's robot side, its far side `extra` from the panel
+        backing = model._backing(row, 2, hp - 0.01 * n, hp, n, pose, -1, np.zeros(3), None)
+        assert backing.surface == "fence panel 1" and backing.distance == pytest.approx(thick + extra)
+        assert backing.thickness == pytest.approx(thick) and backing.travel == 0.0 and backing.v_push == 0.0
+        assert (backing.gap <= 0.02) == clamped
