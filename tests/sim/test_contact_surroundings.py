@@ -159,3 +159,21 @@ def test_a_trunk_pushed_against_a_fence_panel_is_backed_by_it():
         assert backing.surface == "fence panel 1" and backing.distance == pytest.approx(thick + extra)
         assert backing.thickness == pytest.approx(thick) and backing.travel == 0.0 and backing.v_push == 0.0
         assert (backing.gap <= 0.02) == clamped
+
+
+def test_the_reported_verdict_is_the_one_the_simulator_judged():
+    """For every episode, the verdicts `verdict_at` reports (search results, replay, verify's witnesses, the
+    report) agree with where the simulator ended the episode: every earlier contact safe, the last one unsafe."""
+    sim = Simulator(with_criterion(load_cell("s3-fence-gap"), "iso15066"))
+    unsafe = 0
+    for acts in np.random.default_rng(1).integers(0, sim.n_actions, (200, 8)).tolist():
+        trace = sim.run(acts)
+        touching = np.flatnonzero(trace.rows[:, L.M_D] <= 0.0)
+        verdicts = [sim.verdict_at(trace, int(i)).unsafe for i in touching if i > 0]
+        if trace.unsafe:
+            unsafe += 1
+            assert verdicts and verdicts[-1] and not any(verdicts[:-1])
+            assert touching[-1] == trace.unsafe_row == len(trace.rows) - 1
+        else:
+            assert not any(verdicts)
+    assert unsafe >= 1
