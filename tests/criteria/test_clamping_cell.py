@@ -86,3 +86,19 @@ def test_a_search_that_finds_nothing_names_the_case_of_its_strongest_contact():
         break
     else:
         pytest.fail("no safe episode with a contact in 300")
+
+
+def test_the_fixed_twin_keeps_a_hand_gap_and_is_searched_clean():
+    """clamp-table-ok: the same cell with the pick raised so that the gripper stays 100 mm over the table (ISO
+    13854's gap for a hand). Hands still touch the creeping robot, but none is clamped and none is unsafe."""
+    twin = Path(__file__).parent / "cells" / "clamp-table-ok.yaml"
+    assert not cellstress.search(twin, "plan", budget=200, seed=0).found
+    sim = Simulator(twin)
+    acts = np.random.default_rng(0).integers(0, sim.n_actions, (300, 8))
+    batch = sim.run_batch(acts)
+    touched = np.flatnonzero(batch.min_d <= 0.0)
+    assert len(touched) >= 20 and not batch.unsafe.any()
+    for e in touched[:20]:
+        trace = sim.run(acts[e].tolist())
+        for i in np.flatnonzero(trace.rows[:, L.M_D] <= 0.0):
+            assert sim.verdict_at(trace, int(i)).case == "transient"
