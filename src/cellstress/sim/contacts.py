@@ -94,17 +94,15 @@ class ContactModel:
         thick = clamping.body_thickness(self.layout, part, pose)
         d = n
         speed = float(np.linalg.norm(v_point))
-        if part in (L.PART_LEFT_REACH, L.PART_RIGHT_REACH):
-            if speed > 1e-9:
-                d = v_point / speed
-            pinned = self._pinning_point(row, thick)
-            here = self.surfaces.nearest(hp, d)
-            if pinned is not None and (here is None or pinned[0][1] < here[1]):
-                (name, dist), point, d, v_push, jp = pinned
-                jm = self._mass_along(jp, point, row, d)
-                return Backing(name, dist, thick, _p3(d), v_push, jm,
-                               self._travel(row, jp, point, d, v_push, dist - thick))
+        reach = part in (L.PART_LEFT_REACH, L.PART_RIGHT_REACH)
+        if reach and speed > 1e-9:
+            d = v_point / speed
         hit = self.surfaces.nearest(hp, d)
+        pinned = self._pinning_point(row) if reach else None
+        if pinned is not None and (hit is None or pinned[0][1] < hit[1]):
+            (name, dist), point, d, v_push, jp = pinned
+            return Backing(name, dist, thick, _p3(d), v_push, self._mass_along(jp, point, row, d),
+                           self._travel(row, jp, point, d, v_push, dist - thick))
         if hit is None:
             return None
         v_push = max(0.0, float(d @ v_point))
@@ -117,7 +115,7 @@ class ContactModel:
             return 0.0
         return clamping.travel(self.layout, row, joint, point, d, v_push)
 
-    def _pinning_point(self, row, thickness: float):
+    def _pinning_point(self, row):
         """((surface, distance), point, direction, speed, joint) of the robot surface point inside the worker's
         envelope with the nearest fixed surface ahead of it (the least gap; the first such point on a tie), or
         None (``clamping.robot_surface_points``)."""
