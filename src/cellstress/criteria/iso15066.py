@@ -101,11 +101,11 @@ def clamping_force(v_push: float, m_push: float, k_n_per_m: float, travel: float
     """The force [N] on a body region clamped against a fixed surface, from the robot alone: the larger of the
     robot's kinetic energy along the push compressed into the region (1/2 m_R v^2 = F^2 / (2 k): the region cannot
     recoil, so the reduced mass is the robot's own) and the region compressed by the robot's further travel
-    until it stands (F = k * travel). docs/criteria.md derives both."""
-    if v_push <= 0.0:
+    until it stands (F = k * travel). docs/criteria.md derives both. An infinite reflected mass (the joints cannot
+    move the point along the push, to numerical precision) has no kinetic energy along it to speak of: the travel
+    term alone, the robot driving the point along its path, gives the force (and keeps it finite)."""
+    if v_push <= 0.0 or math.isinf(m_push):
         energy = 0.0
-    elif math.isinf(m_push):
-        energy = math.inf
     else:
         energy = v_push * math.sqrt(m_push * k_n_per_m)
     return max(energy, k_n_per_m * max(0.0, travel))
@@ -166,7 +166,8 @@ class Iso15066(CriterionRecord):
     """``payload`` [kg] is added to the robot's reflected mass (see docs/criteria.md)."""
 
     type: Literal["iso15066"] = "iso15066"
-    """A contact is unsafe when its estimated force exceeds the ISO/TS 15066 transient limit of its body region."""
+    """A contact is unsafe when its estimated force exceeds the ISO/TS 15066 limit of its body region (quasi-static
+    when the region is clamped against a fixed surface, transient otherwise)."""
     payload: Annotated[float, Field(ge=0.0, le=1000.0)] = 2.0
     """Mass [kg] added to the robot's reflected mass (tool and part)."""
 
