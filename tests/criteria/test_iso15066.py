@@ -98,18 +98,22 @@ def test_hand_contact_at_low_speed_is_safe_under_iso_but_not_under_the_paper():
     assert f < transient_limit("hands")
     assert not Iso15066().rule("hands", f, moving=True)[0]
     assert ContactWhileMoving().is_unsafe(0.0, 0.3)
-    # and in the simulator: the S3 witness reaches the robot's forearm with the hand at about 0.6 m/s
+    # and in the simulator: the S3 witness reaches the robot's forearm, the robot's point at about 0.6 m/s
     paper = Simulator("s3-fence-gap").run(S3_WITNESS)
     assert paper.unsafe and paper.record(paper.unsafe_row).body_part == "left-reach"
     iso = Simulator(with_criterion(load_cell("s3-fence-gap"), "iso15066"))
     trace = iso.run(S3_WITNESS)
-    assert not trace.unsafe
-    touching = [r for r in trace.rows if r[L.M_D] <= 0.0]
-    assert touching  # the same contact happens, it is just not unsafe
-    for r in touching:
-        c = iso.verdict(r)
-        assert c.touching and c.moving and c.region == "hands"
-        assert 0.0 < c.force < c.limit == 280.0 and not c.unsafe
+    touching = [i for i, r in enumerate(trace.rows) if r[L.M_D] <= 0.0]
+    assert touching == [trace.unsafe_row]  # the same contact happens at the same step
+    c = iso.contacts.contact(trace.rows[touching[0]])  # without the step before: the robot's speed alone
+    alone = iso.criterion.judge(c)
+    assert alone.touching and alone.moving and alone.region == "hands" and alone.case == "transient"
+    assert 0.0 < alone.force < alone.limit == 280.0 and not alone.unsafe
+    # with the worker's own speed (the hand swung towards the robot as the trunk bends, 1.3 m/s) it is unsafe
+    v = iso.verdict_at(trace, touching[0])
+    assert v.unsafe and v.v_human > 1.0 and v.force > 280.0 and v.case == "transient"
+    assert v.reason.startswith(f"{v.force:.0f} N > 280 N transient limit (hands): no fixed surface behind the body")
+    assert v.reason.endswith(f"v_rel {v.v_rel:.2f} m/s with the worker's {v.v_human:.2f} m/s towards the robot")
 
 
 def test_head_contact_while_moving_is_unsafe_at_any_force():
@@ -174,7 +178,7 @@ def test_reward_guards():
 class _Strict(Iso15066):
     """A test criterion with a 50 N limit everywhere, so that the S3 cell has iso15066 hazards."""
 
-    def rule(self, region, force, moving):
+    def rule(self, region, force, moving, clamped=False):
         return (force > 50.0, "test") if force > 50.0 else (False, None)
 
 

@@ -52,7 +52,7 @@ def simulate(
         r = records[hit]
         hazard = {k: r[k] for k in ("t", "step", "robot_link", "body_part", "robot_point", "human_point",
                                     "d_HR", "v_R")}
-        verdict = sim.verdict(trace.rows[hit])
+        verdict = sim.verdict_at(trace, hit)
         if verdict is not None:  # a criterion that judges contacts: its account of this one
             hazard[sim.criterion.type] = verdict.as_dict()
 

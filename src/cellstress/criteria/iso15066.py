@@ -1,16 +1,21 @@
 """ISO/TS 15066 power and force limiting: a collision force estimate per body region, and its limits.
 
-A contact (d_HR <= distance tolerance) is **unsafe** when
+A contact (d_HR <= distance tolerance) is **quasi-static** (clamping) when a fixed surface of the cell lies behind
+the body region, along the direction the robot pushes it, within the region's thickness + ``CLAMP_TOLERANCE``;
+**transient** otherwise. It is **unsafe** when
 
 * the robot moves (v_R > speed tolerance) and the contact is on the skull/forehead or the face, or
-* the predicted peak transient force F exceeds the region's transient limit, 2x its quasi-static limit.
+* the predicted peak force F exceeds the region's limit: its quasi-static limit (Table A.2) when clamped, the
+  transient limit (2x) otherwise.
 
-F = v_rel * sqrt(mu * k) (ISO/TS 15066 Annex A, eq. A.6 rearranged for F), with the reduced mass
+Transient: F = v_rel * sqrt(mu * k) (ISO/TS 15066 Annex A, eq. A.6 rearranged for F), with the reduced mass
 mu = (1/m_H + 1/m_R)^-1, the region's effective mass m_H and spring constant k (Table A.3), the robot's
 effective mass m_R at the contact point along the contact normal n (the reflected mass the simulator computes
 with pinocchio, ``robot.dynamics``, plus the payload), and v_rel the speed of the robot's contact point towards
-the human along n. The worker's own motion is not included: see docs/criteria.md for why. Every number and its
-source: docs/criteria.md.
+the human along n plus, while the robot moves faster than ``CREEP_SPEED``, the worker's own speed towards the robot
+along n (capped at ``HUMAN_SPEED_CAP``). Clamping: the body region cannot recoil, so the robot's whole effective
+mass is felt, and the robot keeps pushing until it stands: F = max(transient F, v_push sqrt(m_R k), k * travel).
+Derivations and every number's source: docs/criteria.md.
 
 The simulator has no fast path for this criterion: it hands every contact to ``judge`` (``core.records.Contact``:
 body region, normal, v_rel and reflected mass at the closest points), and the force ratio at every action end to
@@ -21,12 +26,13 @@ transient limit, and is guarded against reward hacking (see its docstring).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Annotated, Any, Literal
 
 from pydantic import Field
 
 from cellstress.core.records import Contact, Measures
+from cellstress.core.surroundings import Backing
 from cellstress.criteria.base import CriterionRecord, safety_index
 
 # ---- ISO/TS 15066:2016 Annex A ------------------------------------------------------------------------------
@@ -48,6 +54,15 @@ REGIONS: dict[str, tuple[float, float, float]] = {
 }
 TRANSIENT_FACTOR = 2.0
 HEAD_REGIONS = ("skull-forehead", "face")  # no contact while the robot moves
+# A fixed surface at most this far beyond the body region's far side (its capsule's thickness behind the contact
+# point) makes the contact clamping: the body's envelope is approximate, and a centimetre or two of compliant
+# tissue, clothing or glove closes such a gap (our choice, docs/criteria.md).
+CLAMP_TOLERANCE = 0.02  # m
+# The worker's own speed towards the robot counts up to this: ISO 13855's approach speed of a hand or arm,
+# K = 2000 mm/s (ISO 13855:2010, 6.2.3). The kinematic worker's posture changes move a body point faster than a
+# person can (up to 0.68 m in a 50 ms step for the articulated hand), which would make the model, not the robot,
+# the hazard.
+HUMAN_SPEED_CAP = 2.0  # m/s
 
 def transient_limit(region: str) -> float:
     return TRANSIENT_FACTOR * REGIONS[region][0]
@@ -78,77 +93,146 @@ def region_force(region: str, v_rel: float, m_robot: float) -> float:
     return peak_force(v_rel, m_robot, m_h, k * 1000.0)
 
 
+def quasi_static_limit(region: str) -> float:
+    return REGIONS[region][0]
+
+
+def clamping_force(v_push: float, m_push: float, k_n_per_m: float, travel: float) -> float:
+    """The force [N] on a body region clamped against a fixed surface, from the robot alone: the larger of the
+    robot's kinetic energy along the push compressed into the region (1/2 m_R v^2 = F^2 / (2 k): the region cannot
+    recoil, so the reduced mass is the robot's own) and the region compressed by the robot's further travel
+    until it stands (F = k * travel). docs/criteria.md derives both. An infinite reflected mass (the joints cannot
+    move the point along the push, to numerical precision) has no kinetic energy along it to speak of: the travel
+    term alone, the robot driving the point along its path, gives the force (and keeps it finite)."""
+    if v_push <= 0.0 or math.isinf(m_push):
+        energy = 0.0
+    else:
+        energy = v_push * math.sqrt(m_push * k_n_per_m)
+    return max(energy, k_n_per_m * max(0.0, travel))
+
+
 @dataclass(frozen=True)
 class ForceVerdict:
     """The force estimate of one contact (at the closest points, whether touching or not) and its judgement."""
 
     region: str
     normal: tuple[float, float, float]  # unit, from the robot towards the human
-    v_rel: float  # m/s, the robot point's speed towards the human along the normal
+    v_rel: float  # m/s, the relative speed along the normal: the robot point's, plus the worker's counted
     m_robot: float  # kg, reflected mass + payload
     m_human: float
     k: float  # N/m
     force: float  # N
-    limit: float  # N, transient limit
+    limit: float  # N: the quasi-static limit when clamped, else the transient limit
     touching: bool
     moving: bool
     unsafe: bool
     reason: str | None
+    case: str = "transient"  # or "clamping"
+    v_human: float = 0.0  # m/s, the worker's speed towards the robot counted in v_rel
+    backing: Backing | None = None  # the fixed surface found behind the body region (within the search range)
 
     @property
     def ratio(self) -> float:
         return self.force / self.limit
 
+    def why_case(self) -> str:
+        """Why the contact is clamping or transient, in words: the surface found and the gap."""
+        b = self.backing
+        if b is None:
+            return "no fixed surface behind the body region"
+        where = (f"{b.surface} {b.distance * 1000:.0f} mm behind the contact, the body region "
+                 f"{b.thickness * 1000:.0f} mm thick")
+        if self.case == "clamping":
+            return f"clamped against the {where}"
+        return f"free: the {where} (gap {b.gap * 1000:.0f} mm > {CLAMP_TOLERANCE * 1000:.0f} mm)"
+
     def summary(self) -> str:
-        text = f"{self.force:.0f} N against a {self.limit:.0f} N limit ({self.region})"
-        return f"{self.reason}" if self.reason else text
+        if self.reason:
+            return self.reason
+        kind = "quasi-static" if self.case == "clamping" else "transient"
+        return f"{self.force:.0f} N against a {self.limit:.0f} N limit ({kind}, {self.region}; {self.why_case()})"
 
     def as_dict(self) -> dict[str, Any]:
+        b = self.backing
         return {"region": self.region, "normal": list(self.normal), "v_rel": self.v_rel,
                 "m_robot": self.m_robot, "m_human": self.m_human, "k_N_per_m": self.k, "force_N": self.force,
-                "limit_N": self.limit, "ratio": self.ratio, "unsafe": self.unsafe, "reason": self.reason}
+                "limit_N": self.limit, "ratio": self.ratio, "unsafe": self.unsafe, "reason": self.reason,
+                "case": self.case, "v_human": self.v_human, "why_case": self.why_case(),
+                "surface": None if b is None else b.surface, "gap_m": None if b is None else b.gap,
+                "travel_m": b.travel if self.case == "clamping" else None}
 
 
 class Iso15066(CriterionRecord):
     """``payload`` [kg] is added to the robot's reflected mass (see docs/criteria.md)."""
 
     type: Literal["iso15066"] = "iso15066"
-    """A contact is unsafe when its estimated force exceeds the ISO/TS 15066 transient limit of its body region."""
+    """A contact is unsafe when its estimated force exceeds the ISO/TS 15066 limit of its body region (quasi-static
+    when the region is clamped against a fixed surface, transient otherwise)."""
     payload: Annotated[float, Field(ge=0.0, le=1000.0)] = 2.0
     """Mass [kg] added to the robot's reflected mass (tool and part)."""
 
     def describe(self) -> str:
-        return ("unsafe when a contact's estimated peak force exceeds the ISO/TS 15066 transient limit of the body "
-                "region touched, or the head is touched while the robot moves (robot payload "
+        return ("unsafe when a contact's estimated peak force exceeds the ISO/TS 15066 limit of the body region "
+                "touched (quasi-static when the region is clamped against a fixed surface within its thickness + "
+                f"{CLAMP_TOLERANCE * 1000:.0f} mm, transient otherwise; the worker's own speed towards a robot faster "
+                f"than {CREEP_SPEED:.3f} m/s counted, up to {HUMAN_SPEED_CAP:g} m/s), or the head is touched while "
+                "the robot moves (robot payload "
                 f"{self.payload:g} kg; docs/criteria.md)")
 
-    def rule(self, region: str, force: float, moving: bool) -> tuple[bool, str | None]:
-        """(unsafe, reason) of a contact on ``region`` with the predicted force [N]."""
+    def rule(self, region: str, force: float, moving: bool, clamped: bool = False) -> tuple[bool, str | None]:
+        """(unsafe, reason) of a contact on ``region`` with the predicted force [N]; ``clamped``: judged against
+        the quasi-static limit instead of the transient one."""
         if moving and region in HEAD_REGIONS:
             return True, f"{region} contact while the robot moves"
-        if force > transient_limit(region):
-            return True, f"{force:.0f} N > {transient_limit(region):.0f} N transient limit ({region})"
+        limit = quasi_static_limit(region) if clamped else transient_limit(region)
+        if force > limit:
+            kind = "quasi-static" if clamped else "transient"
+            return True, f"{force:.0f} N > {limit:.0f} N {kind} limit ({region})"
         return False, None
+
+    @staticmethod
+    def clamped(backing: Backing | None) -> bool:
+        """A fixed surface within the body region's thickness + CLAMP_TOLERANCE behind the contact point."""
+        return backing is not None and backing.gap <= CLAMP_TOLERANCE
 
     def kernel_test(self) -> None:
         return None
 
     def assess(self, contact: Contact) -> ForceVerdict:
-        """The force estimate at ``contact`` and its verdict."""
+        """The force estimate at ``contact`` and its verdict. A plain ``core.records.Contact`` (no surroundings)
+        is judged transient, with the robot's speed alone; a ``core.surroundings.ContactInCell`` as the module
+        docstring says."""
         m_r = contact.reflected_mass + self.payload
         _, k, m_h = REGIONS[contact.region]
-        force = peak_force(contact.v_rel, m_r, m_h, k * 1000.0)
-        touching = bool(contact.d_hr <= self.distance_tolerance)
+        k = k * 1000.0
         moving = bool(contact.v_r > self.speed_tolerance)
-        unsafe, reason = self.rule(contact.region, force, moving) if touching else (False, None)
-        return ForceVerdict(contact.region, contact.normal, contact.v_rel, m_r, m_h, k * 1000.0, force,
-                            transient_limit(contact.region), touching, moving, unsafe, reason)
+        # the worker's speed towards the robot counts while the robot moves faster than it creeps: below
+        # CREEP_SPEED the robot's own motion brings no region but the head over its limit, and the worker meets
+        # a robot that practically stands, as they would a machine part (docs/criteria.md)
+        v_human = min(HUMAN_SPEED_CAP, float(getattr(contact, "v_human", 0.0))) if contact.v_r > CREEP_SPEED else 0.0
+        v_rel = contact.v_rel + v_human
+        force = peak_force(v_rel, m_r, m_h, k)
+        backing = getattr(contact, "backing", None)
+        clamped = self.clamped(backing)
+        if clamped:
+            force = max(force, clamping_force(backing.v_push, backing.m_push + self.payload, k, backing.travel))
+        touching = bool(contact.d_hr <= self.distance_tolerance)
+        unsafe, reason = self.rule(contact.region, force, moving, clamped) if touching else (False, None)
+        verdict = ForceVerdict(contact.region, contact.normal, v_rel, m_r, m_h, k, force,
+                               quasi_static_limit(contact.region) if clamped else transient_limit(contact.region),
+                               touching, moving, unsafe, reason, "clamping" if clamped else "transient", v_human,
+                               backing)
+        if reason is None:
+            return verdict
+        worker = f"; v_rel {v_rel:.2f} m/s with the worker's {v_human:.2f} m/s towards the robot" if v_human else ""
+        return replace(verdict, reason=f"{reason}: {verdict.why_case()}{worker}")
 
     def judge(self, contact: Contact) -> ForceVerdict:
         return self.assess(contact)
 
     def severity(self, contact: Contact) -> float:
-        """The predicted force over the transient limit at the closest points, as if they touched now."""
+        """The predicted force over its limit (quasi-static when clamped, else transient) at the closest points,
+        as if they touched now."""
         return float(self.assess(contact).ratio)
 
     @staticmethod

@@ -72,7 +72,7 @@ def strongest_contact(sim, actions) -> str | None:
         return None
     trace = sim.run(list(actions))
     tol = sim.criterion.distance_tolerance
-    verdicts = [sim.verdict(row) for row, rec in zip(trace.rows, trace.records(), strict=True) if rec.d_HR <= tol]
+    verdicts = [sim.verdict_at(trace, i) for i, rec in enumerate(trace.records()) if rec.d_HR <= tol]
     if not verdicts:
         return None
     worst = max(verdicts, key=lambda v: getattr(v, "ratio", 0.0))

@@ -201,7 +201,7 @@ def hazard_record(sim: Simulator, episode: int, actions: list[str]) -> Hazard:
     search writes it, and ``replay`` makes it again to check every claim of a result file."""
     trace, records = _unsafe_row(sim, actions)
     hit = records[trace.unsafe_row]
-    verdict = sim.verdict(trace.rows[trace.unsafe_row])  # a criterion that judges contacts: its account
+    verdict = sim.verdict_at(trace, trace.unsafe_row)  # a criterion that judges contacts: its account
     return Hazard.model_construct(
         episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.moment, robot_link=hit.robot_link,
         body_part=hit.body_part, point=hit.robot_point, human_point=hit.human_point, v_R=hit.v_R, d_HR=hit.d_HR,
@@ -214,7 +214,7 @@ def distinct_record(sim: Simulator, klass, episode: int, actions: list[str]) -> 
     """The record of a distinct class's first hazard (see ``hazard_record``)."""
     trace, records = _unsafe_row(sim, actions)
     hit = records[trace.unsafe_row]
-    verdict = sim.verdict(trace.rows[trace.unsafe_row])
+    verdict = sim.verdict_at(trace, trace.unsafe_row)
     return DistinctHazard.model_construct(
         klass=klass, episode=episode, actions=tuple(actions), step=hit.step, time_s=hit.moment,
         robot_link=hit.robot_link, body_part=hit.body_part, v_R=hit.v_R, trace=records,

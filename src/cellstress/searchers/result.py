@@ -136,16 +136,16 @@ class Why(Record):
 class Severity(Record):
     """How bad a hazard's contact is (``searchers.severity``): the robot's speed there and, under a criterion that
     judges forces (iso15066), the predicted force over its limit; ``creeping``: the robot slower than
-    ``criteria.iso15066.CREEP_SPEED`` (no transient contact can exceed a limit but the head's). Findings are
-    listed worst first, creeping ones after the others."""
+    ``criteria.iso15066.CREEP_SPEED`` (no transient contact can exceed a limit but the head's) and the contact not
+    clamping. Findings are listed worst first, creeping ones after the others."""
 
     v_R: Annotated[float, Field(ge=0.0, le=1000.0)]
     """The robot's speed at the contact [m/s] (the simulator's v_R: its fastest joint)."""
     force_ratio: Annotated[float, Field(ge=0.0, le=1e9)] | None = None
-    """The predicted peak force over the body region's transient limit (iso15066; a head contact while the robot
-    moves counts at least 1); absent for other criteria."""
+    """The predicted peak force over the body region's limit (iso15066: quasi-static when clamped, else transient;
+    a head contact while the robot moves counts at least 1); absent for other criteria."""
     creeping: bool
-    """v_R below the creep speed: shown apart, after the others."""
+    """v_R below the creep speed (a transient contact): shown apart, after the others."""
 
     @model_serializer(mode="wrap")
     def _drop_absent(self, handler):

@@ -3,12 +3,14 @@
 
 A hazard's severity is its contact speed: v_R at the unsafe step, the speed of the robot touched (the paper's
 measure, the one the contact criterion judges). Under a criterion that judges forces (``iso15066``) it is the
-predicted peak force over the transient limit of the body region touched, a head contact while the robot moves
-counting at least 1 (its limit is any contact at all). A contact while the robot creeps, slower than
-``criteria.iso15066.CREEP_SPEED`` (0.123 m/s: below it no transient contact exceeds its ISO/TS 15066 limit on any
-body region but the head, however heavy the robot), is still a finding of the criterion, but it is listed after
-every faster one: a robot at the end of its braking that a worker leans against is not the first thing to fix.
-Ties keep the order found.
+predicted peak force over the limit of the body region touched (quasi-static when it is clamped, transient
+otherwise), a head contact while the robot moves counting at least 1 (its limit is any contact at all). A transient
+contact while the robot creeps, slower than ``criteria.iso15066.CREEP_SPEED`` (0.123 m/s: below it the robot's
+motion brings no transient contact over its ISO/TS 15066 limit on any body region but the head, however heavy the
+robot), is still a finding of the criterion, but it is listed after every faster one: a robot at the end of its
+braking that a worker leans against is not the first thing to fix. A clamping contact is never listed apart: a
+creeping robot that keeps pushing a hand against the table until it stands is the hazard itself. Ties keep the
+order found.
 """
 
 from __future__ import annotations
@@ -29,7 +31,9 @@ def severity(v_r: float | None, verdict: dict | None) -> Severity:
         if "contact while the robot moves" in reason:
             ratio = max(ratio, 1.0)
     v = 0.0 if v_r is None else float(v_r)
-    return Severity.model_construct(v_R=v, force_ratio=ratio, creeping=bool(v < CREEP_SPEED))
+    # the creep speed bounds transient contacts only: a clamping one (iso15066) is never listed apart
+    clamping = verdict is not None and verdict.get("case") == "clamping"
+    return Severity.model_construct(v_R=v, force_ratio=ratio, creeping=bool(v < CREEP_SPEED and not clamping))
 
 
 def rank(s: Severity | None) -> tuple[bool, float]:

@@ -3,8 +3,10 @@
 Everything a criterion may need about a contact that the compiled loop does not compute: the ISO/TS 15066
 body region of the human point (``human.regions``), the contact normal (``scene.contact_normal``), the robot's
 joint state at that step (from the kernel's own trajectory) and, from pinocchio, the robot point's velocity
-towards the human and the robot's reflected mass along the normal (``robot.dynamics``). Contacts are rare, so
-this runs in Python, outside the hot loop.
+towards the human and the robot's reflected mass along the normal (``robot.dynamics``); and what surrounds the
+contact (``sim.clamping``): the fixed surface behind the body region, the robot's travel towards it until it
+stands, the worker's own speed towards the robot. Contacts are rare, so this runs in Python, outside the hot
+loop.
 """
 
 from __future__ import annotations
@@ -14,13 +16,14 @@ import math
 import numpy as np
 
 from cellstress.core.errors import CellstressError
-from cellstress.core.records import Contact
+from cellstress.core.surroundings import Backing, ContactInCell
 from cellstress.human.body import BODY_PARTS
 from cellstress.human.regions import body_region
 from cellstress.robot.dynamics import point_dynamics, reflected_mass
 from cellstress.robot.model import load_pinocchio
+from cellstress.sim import clamping, scene
+from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
-from cellstress.sim import scene
 from cellstress.sim.build import Layout
 
 
@@ -42,9 +45,13 @@ class ContactModel:
         # of the driven joints only (None: every joint is driven, nothing to reduce)
         jm = layout.joints
         self.reduce = None if len(jm.driven) == layout.robot.n_joints else jm.jacobian_map()
+        self.surfaces = clamping.FixedSurfaces(layout)
+        self._work = K.make_work(P)  # the worker-only kernels' scratch (clamping.robot_surface_points)
 
-    def contact(self, row: np.ndarray) -> Contact:
-        """The closest points of a metric row, with the region, normal, v_rel and reflected mass there."""
+    def contact(self, row: np.ndarray, before: np.ndarray | None = None) -> ContactInCell:
+        """The closest points of a metric row, with the region, normal, v_rel and reflected mass there, and its
+        surroundings. ``before`` is the worker's pose vector (``layout.POSE_ROW``'s order) one time step earlier:
+        the worker's speed is estimated from it (None: taken as 0)."""
         lay, P = self.layout, self.layout.params
         link, part = int(row[L.M_LINK]), int(row[L.M_PART])
         rp = np.array(row[L.M_RX:L.M_RZ + 1], dtype=float)
@@ -56,17 +63,81 @@ class ContactModel:
         region = body_region(part, hp, pose, b.height, b.upper_arm, b.forearm)
         j = int(P.cap_joint[link])
         if j < 0:  # a capsule on the fixed base
-            v_rel, m_r = 0.0, math.inf
+            v_rel, m_r, v_point = 0.0, math.inf, np.zeros(3)
+            mass = None
         else:
             pb = self.R_base.T @ (rp - self.t_base)  # pinocchio works in the robot base frame
-            nb = self.R_base.T @ n
             Jp, M = point_dynamics(self.model, self.data, lay.robot.pinocchio_q(q), j + 1, pb)
-            if self.reduce is None:
-                m_r = reflected_mass(Jp, M, nb)
-            else:
-                e = self.reduce
-                m_r = reflected_mass(Jp @ e, e.T @ M @ e, nb)
-            v_rel = max(0.0, float(nb @ (Jp @ qd)))
-        return Contact(float(row[L.M_D]), float(row[L.M_V]), lay.capsules[link].name, BODY_PARTS[part], region,
-                       (float(rp[0]), float(rp[1]), float(rp[2])), (float(hp[0]), float(hp[1]), float(hp[2])),
-                       (float(n[0]), float(n[1]), float(n[2])), v_rel, m_r)
+            v_base = Jp @ qd
+            v_point = self.R_base @ v_base
+            Jm, Mm = (Jp, M) if self.reduce is None else (Jp @ self.reduce, self.reduce.T @ M @ self.reduce)
+
+            def mass(u: np.ndarray) -> float:
+                return reflected_mass(Jm, Mm, self.R_base.T @ u)
+
+            m_r = mass(n)
+            v_rel = max(0.0, float((self.R_base.T @ n) @ v_base))
+        v_human = 0.0
+        if before is not None:
+            v = clamping.body_point_velocity(part, hp, pose, scene.body_pose(lay, before), float(P.scal[L.C_DT]))
+            v_human = max(0.0, -float(n @ v))
+        backing = None  # apart (d_HR over any criterion's distance tolerance) nothing is clamped yet
+        if float(row[L.M_D]) <= clamping.CONTACT_RANGE:
+            backing = self._backing(row, part, rp, hp, n, pose, j, v_point, mass)
+        return ContactInCell(float(row[L.M_D]), float(row[L.M_V]), lay.capsules[link].name, BODY_PARTS[part],
+                             region, _p3(rp), _p3(hp), _p3(n), v_rel, m_r, v_human, backing)
+
+    def _backing(self, row, part, rp, hp, n, pose, j, v_point, mass) -> Backing | None:
+        """The nearest fixed surface behind the body region along the push direction: the contact normal for a
+        body capsule; for a reach volume (a hand anywhere in it) the robot point's own direction of motion, and
+        the robot surface point anywhere in the worker's envelope that pins a hand with the least gap."""
+        thick = clamping.body_thickness(self.layout, part, pose)
+        d = n
+        speed = float(np.linalg.norm(v_point))
+        reach = part in (L.PART_LEFT_REACH, L.PART_RIGHT_REACH)
+        if reach and speed > 1e-9:
+            d = v_point / speed
+        hit = self.surfaces.nearest(hp, d)
+        pinned = self._pinning_point(row) if reach else None
+        if pinned is not None and (hit is None or pinned[0][1] < hit[1]):
+            (name, dist), point, d, v_push, jp = pinned
+            return Backing(name, dist, thick, _p3(d), v_push, self._mass_along(jp, point, row, d),
+                           self._travel(row, jp, point, d, v_push, dist - thick))
+        if hit is None:
+            return None
+        v_push = max(0.0, float(d @ v_point))
+        return Backing(hit[0], hit[1], thick, _p3(d), v_push, math.inf if mass is None else mass(d),
+                       self._travel(row, j, rp, d, v_push, hit[1] - thick))
+
+    def _travel(self, row, joint: int, point, d, v_push: float, gap: float) -> float:
+        """The robot point's travel along ``d`` until standstill, behind a gap of at most TRAVEL_GAP; else 0."""
+        if gap > clamping.TRAVEL_GAP:
+            return 0.0
+        return clamping.travel(self.layout, row, joint, point, d, v_push)
+
+    def _pinning_point(self, row):
+        """((surface, distance), point, direction, speed, joint) of the robot surface point inside the worker's
+        envelope with the nearest fixed surface ahead of it (the least gap; the first such point on a tie), or
+        None (``clamping.robot_surface_points``)."""
+        points, dirs, speeds, joints = clamping.robot_surface_points(self.layout, row, self._work)
+        if not len(points):
+            return None
+        which, dist = self.surfaces.nearest_many(points, dirs)
+        i = int(np.argmin(dist))  # the first on a tie
+        if which[i] < 0:
+            return None
+        return ((self.surfaces.names[int(which[i])], float(dist[i])), points[i], dirs[i], float(speeds[i]),
+                int(joints[i]))
+
+    def _mass_along(self, joint: int, point: np.ndarray, row, d: np.ndarray) -> float:
+        """The robot's reflected mass [kg] at ``point`` on kernel joint ``joint`` along ``d`` (no payload)."""
+        q, _ = scene.joint_state(self.layout, row)
+        pb = self.R_base.T @ (point - self.t_base)
+        Jp, M = point_dynamics(self.model, self.data, self.layout.robot.pinocchio_q(q), joint + 1, pb)
+        if self.reduce is not None:
+            Jp, M = Jp @ self.reduce, self.reduce.T @ M @ self.reduce
+        return reflected_mass(Jp, M, self.R_base.T @ d)
+
+
+def _p3(v) -> tuple[float, float, float]:
+    return (float(v[0]), float(v[1]), float(v[2]))

@@ -205,7 +205,7 @@ class Simulator:
         n = K.step_with_handle(self._handle, nxt, a, self._rows)
         rows = self._rows[:n].copy()
         if self.contacts is not None and n:
-            i = self.first_unsafe(rows)
+            i = self.first_unsafe(rows, state[_POSE_STATE])
             if i is not None:  # the criterion's unsafe step ends the episode there, as the kernel's would
                 rows = rows[:i + 1]
                 rows[i, L.M_UNSAFE] = 1.0
@@ -229,26 +229,38 @@ class Simulator:
                 out[i] = rows[-1]
         return out
 
-    def first_unsafe(self, rows: np.ndarray) -> int | None:
-        """Index of the first row the criterion judges unsafe (contacts only: they are rare)."""
+    def first_unsafe(self, rows: np.ndarray, before: np.ndarray | None = None) -> int | None:
+        """Index of the first row the criterion judges unsafe (contacts only: they are rare). ``before``: the
+        worker's pose vector one step before ``rows[0]`` (the state the rows were played from), for the worker's
+        speed at a contact in the first row."""
         tol = self.criterion.distance_tolerance
         for i in np.flatnonzero(rows[:, L.M_D] <= tol):
-            if self.criterion.judge(self.contacts.contact(rows[i])).unsafe:
+            prev = before if i == 0 else L.row_pose(rows[i - 1])
+            if self.criterion.judge(self.contacts.contact(rows[i], prev)).unsafe:
                 return int(i)
         return None
 
-    def verdict(self, row: np.ndarray):
+    def verdict(self, row: np.ndarray, prev: np.ndarray | None = None):
         """The criterion's verdict on a row's closest points (``core.protocols.Verdict``), for a criterion that
-        judges contacts; None for one with a kernel fast path."""
-        return None if self.contacts is None else self.criterion.judge(self.contacts.contact(row))
+        judges contacts; None for one with a kernel fast path. ``prev`` is the metric row one step earlier (the
+        worker's speed at the contact comes from the pose change; give it wherever the trace has it, as
+        ``Trace.rows[i - 1]``, so that the verdict is the one the simulator judged)."""
+        if self.contacts is None:
+            return None
+        return self.criterion.judge(self.contacts.contact(row, None if prev is None else L.row_pose(prev)))
+
+    def verdict_at(self, trace: Trace, i: int):
+        """The verdict on row ``i`` of ``trace`` (``verdict`` with the row before it)."""
+        return self.verdict(trace.rows[i], trace.rows[i - 1] if i > 0 else None)
 
     def measures(self, rows: np.ndarray) -> Measures:
         """What the reward sees of an action: d_HR and v_R at its last step (and the criterion's severity there)."""
         last = rows[-1]
         if self.contacts is None:
             return Measures(float(last[L.M_D]), float(last[L.M_V]))
+        prev = L.row_pose(rows[-2]) if len(rows) > 1 else None
         return Measures(float(last[L.M_D]), float(last[L.M_V]),
-                        float(self.criterion.severity(self.contacts.contact(last))))
+                        float(self.criterion.severity(self.contacts.contact(last, prev))))
 
     @staticmethod
     def is_unsafe(state: np.ndarray) -> bool:
@@ -379,6 +391,9 @@ class Simulator:
         if self._worker_w is None:
             self._worker_w = K.make_work(self.params)
         return self._worker_w
+
+
+_POSE_STATE = list(L.POSE_STATE)
 
 
 def _action_array(actions, n_actions: int) -> np.ndarray:

@@ -59,7 +59,7 @@ def witness_severity(sim, actions: tuple[str, ...]) -> Severity:
     """How bad a witness's contact is (``searchers.severity``), from its sequence played in ``sim``'s cell."""
     trace = sim.run(list(actions))
     row = trace.rows[trace.unsafe_row]
-    verdict = sim.verdict(row)
+    verdict = sim.verdict_at(trace, trace.unsafe_row)
     return severity(float(row[M_V]), None if verdict is None else verdict.as_dict())
 
 
