@@ -14,41 +14,43 @@ from cellstress.sim.kernels.sweep import _sample
 from cellstress.sim.layout import C_DT, C_DTOL, NM, NS, S_FWD, S_HEADING, S_K, S_LAT
 
 
-@njit(cache=True, error_model="numpy", parallel=True)
-def dense_batch(P, s0, actions, n_sub, unsafe_step):
-    """unsafe_step[e]: the first step of episode e (actions[e], played from s0 with ``P``'s swept test off) at
-    which the kernel test holds at the step's sample or at one of the ``n_sub - 1`` moments evenly between it
-    and the previous step; -1: none."""
-    n_ep, n_act = actions.shape
+@njit(cache=True, error_model="numpy")
+def dense_episode(P, s0, actions, n_sub):
+    """The first step of the episode ``actions`` (played from s0 with ``P``'s swept test off) at which the kernel
+    test holds at the step's sample or at one of the ``n_sub - 1`` moments evenly between it and the previous
+    step; -1: none. Its own kernel, not inlined into ``dense_batch``'s parallel loop: compiled there (the step's
+    inlined functions under the parallel transforms), it reported contacts the same code called step by step
+    does not (reach-over, numba 0.68), as ``batch.run_batch`` keeps ``step_action`` apart too."""
     spa = P.spa
     dt = P.scal[C_DT]
-    for e in prange(n_ep):
-        W = make_work(P)
-        state = s0.copy()
-        prev = np.empty(NS)
-        row = np.empty(NM)
-        srow = np.empty(NM)
-        unsafe_step[e] = -1
-        done = False
-        for a in range(n_act):
-            action = actions[e, a]
-            h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
-            begin_action(P, state, W)
-            for j in range(1, spa + 1):
-                for i in range(NS):
-                    prev[i] = state[i]
-                move_worker(P, state, action, h0, f0, l0, j / spa, W)
-                state[S_K] += 1.0
-                unsafe = sense_and_measure(P, state, W, row, action)
-                t0 = state[S_K] * dt - dt
-                for m in range(1, n_sub):
-                    if unsafe:
-                        break
-                    d, moving, _ = _sample(P, prev, state, W, m / n_sub, t0, srow)
-                    unsafe = d <= P.scal[C_DTOL] and moving
+    W = make_work(P)
+    state = s0.copy()
+    prev = np.empty(NS)
+    row = np.empty(NM)
+    srow = np.empty(NM)
+    for a in range(actions.shape[0]):
+        action = actions[a]
+        h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
+        begin_action(P, state, W)
+        for j in range(1, spa + 1):
+            for i in range(NS):
+                prev[i] = state[i]
+            move_worker(P, state, action, h0, f0, l0, j / spa, W)
+            state[S_K] += 1.0
+            unsafe = sense_and_measure(P, state, W, row, action)
+            t0 = state[S_K] * dt - dt
+            for m in range(1, n_sub):
                 if unsafe:
-                    unsafe_step[e] = int(state[S_K])
-                    done = True
                     break
-            if done:
-                break
+                d, moving, _ = _sample(P, prev, state, W, m / n_sub, t0, srow)
+                unsafe = d <= P.scal[C_DTOL] and moving
+            if unsafe:
+                return int(state[S_K])
+    return -1
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def dense_batch(P, s0, actions, n_sub, unsafe_step):
+    """unsafe_step[e]: ``dense_episode`` of episode e (actions[e])."""
+    for e in prange(actions.shape[0]):
+        unsafe_step[e] = dense_episode(P, s0, actions[e], n_sub)
