@@ -13,7 +13,9 @@ from cellstress.human.body import B_LEG_HALF
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 from cellstress.sim import scene
-from cellstress.sim.clamping import body_point_velocity, remaining_path_time, time_scaling, travel
+from cellstress.sim.clamping import body_point_velocity, remaining_path_time, travel
+from cellstress.sim.contacts import at_contact
+from cellstress.sim.scene import time_scaling
 from cellstress.sim.simulator import Simulator
 
 DT = 0.05
@@ -138,6 +140,33 @@ def test_contacts_carry_the_worker_speed_and_the_verdict_is_the_judged_one():
     batch = sim.run_batch(np.asarray([[sim.action_index(a) for a in acts]]))
     assert int(batch.unsafe_step[0]) == int(row[L.M_STEP])
     assert sim.run(acts).rows.tobytes() == trace.rows.tobytes()  # the same inputs, the same bytes
+
+
+def test_a_contact_between_the_steps_is_judged_at_its_own_moment():
+    """A contact the swept test found within a step (M_SWEPT 1) holds the poses of its own moment M_TC: the worker,
+    moving at a constant velocity within the step, covered the pose change in M_TC minus the step before's time,
+    so the same pose change half a step after the step before is twice the speed; and the robot's time scaling is
+    read at M_TC (at_contact), not at the step's time."""
+    sim = Simulator(with_criterion(load_cell("s3-fence-gap"), "iso15066"))
+    acts = ["walk+bend-right", "turn-left-45+bend-forward-left", "walk+bend-forward", "walk+bend-forward-left"]
+    trace = sim.run(acts)
+    i = trace.unsafe_row
+    row, prev = trace.rows[i], L.row_pose(trace.rows[i - 1])
+    whole = sim.contacts.contact(row, prev)
+    assert row[L.M_SWEPT] == 0.0 and whole.v_human > 0.0
+    half = np.array(row)
+    half[L.M_SWEPT], half[L.M_TC] = 1.0, row[L.M_T] - sim.dt / 2.0
+    at, elapsed = at_contact(half, sim.dt)
+    assert at[L.M_T] == half[L.M_TC] and elapsed == pytest.approx(sim.dt / 2.0, rel=1e-12)
+    assert at_contact(row, sim.dt)[0] is row and at_contact(row, sim.dt)[1] == sim.dt
+    assert sim.contacts.contact(half, prev).v_human == pytest.approx(2.0 * whole.v_human, rel=1e-9)
+    # a step braking: the time scaling at the contact's own moment, not at the step's
+    braking = np.array(row)
+    braking[L.M_PHASE] = L.PHASE_BRAKING
+    braking[L.M_SWEPT], braking[L.M_TC] = 1.0, row[L.M_T] - sim.dt / 2.0
+    shifted = np.array(braking)
+    shifted[L.M_T] = braking[L.M_TC]
+    assert scene.time_scaling(sim.layout, at_contact(braking, sim.dt)[0]) == scene.time_scaling(sim.layout, shifted)
 
 
 def test_a_trunk_pushed_against_a_fence_panel_is_backed_by_it():

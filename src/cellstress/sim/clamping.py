@@ -27,6 +27,7 @@ import numpy as np
 from cellstress.human.body import CAPSULE_PART, BodyPose
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
+from cellstress.sim import scene
 from cellstress.sim.build import Layout
 
 CAST_RANGE = 0.5  # m: the farthest a backing surface is looked for (a clamping gap is centimetres)
@@ -178,23 +179,6 @@ def body_point_velocity(part: int, point, pose: BodyPose, before: BodyPose, dt: 
     return (now - then) / dt
 
 
-def time_scaling(layout: Layout, row: np.ndarray) -> float:
-    """The robot's time scaling sigma at a metric row: 1 running, falling linearly to 0 while braking, 0 stopped.
-    The same arithmetic as ``scene.joint_state`` (kept there unchanged: scene.py's bytes key a compiled kernel in
-    the shipped cache); tests/sim/test_clamping.py checks that the two agree."""
-    P = layout.params
-    T = float(P.scal[L.C_STOP_TIME])
-    tau, t, phase = float(row[L.M_TAU]), float(row[L.M_T]), int(row[L.M_PHASE])
-    if phase == L.PHASE_STOPPED:
-        return 0.0
-    if phase == L.PHASE_BRAKING and P.scal[L.C_STOP_HOLD] != 0.0:
-        return max(0.0, 1.0 - (t - (tau - float(P.scal[L.C_PHASE0]))) / T)
-    if phase == L.PHASE_BRAKING:
-        d = float(np.sqrt(max(0.0, 2.0 * T * (t + float(P.scal[L.C_PHASE0]) - tau))))
-        return max(0.0, 1.0 - d / T)
-    return 1.0
-
-
 def remaining_path_time(layout: Layout, row: np.ndarray) -> float:
     """Path time [s] the robot still advances until it stands, on its path (see the module docstring): braking,
     sigma^2 T / 2; otherwise delay + T / 2 (running at full path speed until its stop, made by the contact if
@@ -205,7 +189,7 @@ def remaining_path_time(layout: Layout, row: np.ndarray) -> float:
     if phase == L.PHASE_STOPPED:
         return 0.0
     if phase == L.PHASE_BRAKING:
-        sigma = time_scaling(layout, row)
+        sigma = scene.time_scaling(layout, row)
         return sigma * sigma * T / 2.0
     return delay + T / 2.0
 
@@ -220,7 +204,7 @@ def travel(layout: Layout, row: np.ndarray, joint: int, point, direction, v_push
         return 0.0
     T = float(P.scal[L.C_STOP_TIME])
     if P.scal[L.C_STOP_HOLD] != 0.0:
-        left = time_scaling(layout, row) * T if phase == L.PHASE_BRAKING else T
+        left = scene.time_scaling(layout, row) * T if phase == L.PHASE_BRAKING else T
         return max(0.0, v_push) * left / 2.0
     dtau = remaining_path_time(layout, row)
     if dtau <= 0.0:
@@ -252,7 +236,7 @@ def robot_surface_points(layout: Layout, row: np.ndarray, work) -> tuple[np.ndar
     n_caps = P.cap_joint.shape[0]
     nj = P.placements.shape[0]
     tau, h = float(row[L.M_TAU]), 1e-6
-    sigma = time_scaling(layout, row)
+    sigma = scene.time_scaling(layout, row)
     q, qd = np.zeros(nj), np.zeros(nj)
     rot, pos = np.zeros((nj, 3, 3)), np.zeros((nj, 3))
     ends = []

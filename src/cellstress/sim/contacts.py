@@ -27,6 +27,19 @@ from cellstress.sim import layout as L
 from cellstress.sim.build import Layout
 
 
+def at_contact(row: np.ndarray, dt: float) -> tuple[np.ndarray, float]:
+    """A metric row as of its contact's own moment, and the time since the step before. A contact the swept test
+    found between two steps (``M_SWEPT`` 1 or 2) holds the robot and the worker as posed at ``M_TC``, while
+    ``M_T`` is the step's time: the robot's time scaling and the worker's speed (the worker moves at a constant
+    velocity within a step, ``kernels.sweep``) are taken at ``M_TC``. The time since the step before is kept
+    above 1/256 of a step (the finest part the swept test halves a step into)."""
+    if row[L.M_SWEPT] == 0.0 or not row[L.M_TC] >= 0.0:
+        return row, dt
+    at = np.array(row, dtype=float)
+    at[L.M_T] = row[L.M_TC]
+    return at, max(float(row[L.M_TC]) - (float(row[L.M_T]) - dt), dt / 256.0)
+
+
 class ContactModel:
     """Contacts of one simulator layout (pinocchio model and data made once, like the simulator's work arrays)."""
 
@@ -53,6 +66,7 @@ class ContactModel:
         surroundings. ``before`` is the worker's pose vector (``layout.POSE_ROW``'s order) one time step earlier:
         the worker's speed is estimated from it (None: taken as 0)."""
         lay, P = self.layout, self.layout.params
+        row, elapsed = at_contact(row, float(P.scal[L.C_DT]))
         link, part = int(row[L.M_LINK]), int(row[L.M_PART])
         rp = np.array(row[L.M_RX:L.M_RZ + 1], dtype=float)
         hp = np.array(row[L.M_HX:L.M_HZ + 1], dtype=float)
@@ -79,7 +93,7 @@ class ContactModel:
             v_rel = max(0.0, float((self.R_base.T @ n) @ v_base))
         v_human = 0.0
         if before is not None:
-            v = clamping.body_point_velocity(part, hp, pose, scene.body_pose(lay, before), float(P.scal[L.C_DT]))
+            v = clamping.body_point_velocity(part, hp, pose, scene.body_pose(lay, before), elapsed)
             v_human = max(0.0, -float(n @ v))
         backing = None  # apart (d_HR over any criterion's distance tolerance) nothing is clamped yet
         if float(row[L.M_D]) <= clamping.CONTACT_RANGE:

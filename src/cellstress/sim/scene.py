@@ -93,27 +93,31 @@ def reach_points(layout: Layout, pose: BodyPose, side: int, stride: int = 1,
     return pts[keep]
 
 
-def joint_state(layout: Layout, row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The robot's joint positions and velocities (q, q_dot) at a metric row, from the kernel's own trajectory.
-
-    The row holds the path time tau and the stop phase; while braking, the time since the stop took effect
-    follows from tau = tau0 + t_s + d - d^2 / (2 T) with t = t_s + d, so the time-scaling sigma = 1 - d / T (a
-    category 0 stop holds tau = tau0 + t_s, so d = t - (tau - tau0))."""
+def time_scaling(layout: Layout, row: np.ndarray) -> float:
+    """The robot's time scaling sigma at a metric row: 1 running, falling to 0 while braking, 0 stopped. The row
+    holds the path time tau and the stop phase; while braking, the time since the stop took effect follows from
+    tau = tau0 + t_s + d - d^2 / (2 T) with t = t_s + d, so sigma = 1 - d / T (a category 0 stop holds
+    tau = tau0 + t_s, so d = t - (tau - tau0))."""
     P = layout.params
     T = float(P.scal[L.C_STOP_TIME])
     tau, t, phase = float(row[L.M_TAU]), float(row[L.M_T]), int(row[L.M_PHASE])
     if phase == L.PHASE_STOPPED:
-        sigma = 0.0
-    elif phase == L.PHASE_BRAKING and P.scal[L.C_STOP_HOLD] != 0.0:
-        sigma = max(0.0, 1.0 - (t - (tau - float(P.scal[L.C_PHASE0]))) / T)
-    elif phase == L.PHASE_BRAKING:
+        return 0.0
+    if phase == L.PHASE_BRAKING and P.scal[L.C_STOP_HOLD] != 0.0:
+        return max(0.0, 1.0 - (t - (tau - float(P.scal[L.C_PHASE0]))) / T)
+    if phase == L.PHASE_BRAKING:
         d = float(np.sqrt(max(0.0, 2.0 * T * (t + float(P.scal[L.C_PHASE0]) - tau))))
-        sigma = max(0.0, 1.0 - d / T)
-    else:
-        sigma = 1.0
+        return max(0.0, 1.0 - d / T)
+    return 1.0
+
+
+def joint_state(layout: Layout, row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The robot's joint positions and velocities (q, q_dot) at a metric row, from the kernel's own trajectory
+    (at the row's path time, scaled by ``time_scaling``)."""
+    P = layout.params
     nj = P.placements.shape[0]
     q, qd = np.zeros(nj), np.zeros(nj)
-    K.joint_trajectory(P, tau, sigma, q, qd)
+    K.joint_trajectory(P, float(row[L.M_TAU]), time_scaling(layout, row), q, qd)
     return q, qd
 
 

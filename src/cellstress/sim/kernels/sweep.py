@@ -352,8 +352,9 @@ def sweep_step(P, prev, state, W, row):
             if not judged:  # cannot be cleared at the finest sub-step: a contact, conservatively
                 found_t = ta
                 found = 2
-                _sample(P, prev, state, W, sa if da <= db else sb, t0, W.srow)  # the nearer end's, for the row
-                _copy_contact(W.srow, W.crow, ta, 2.0)
+                # the nearer end's pose for the row, with that end's own moment (the contact's time in M_TC)
+                _, _, t_end = _sample(P, prev, state, W, sa if da <= db else sb, t0, W.srow)
+                _copy_contact(W.srow, W.crow, t_end, 2.0)
             continue
         if depth >= SWEEP_DEPTH and cert == 0.0:  # go on with certified lower bounds at both ends
             _sample(P, prev, state, W, sa, t0, W.srow)
