@@ -229,7 +229,7 @@ def test_contact_point_velocity_matches_the_kernel_kinematics():
 
 def test_a_criterion_step_inside_an_action_leaves_the_state_of_that_step():
     """When the criterion ends the episode before an action's last 50 ms step, Simulator.step returns the state
-    of that step: its clock and pose are the unsafe row's, and measuring it again (the kernel's own
+    of that step: its clock and pose are the unsafe row's (a contact within the step: its moment lies in it), and measuring it again (the kernel's own
     sense_and_measure, which also latches stops) reproduces that row and latches nothing new."""
     sim = _strict_s3()
     P = sim.params
@@ -243,6 +243,9 @@ def test_a_criterion_step_inside_an_action_leaves_the_state_of_that_step():
                 continue
             row = rows[-1]
             assert s[L.S_K] == row[L.M_STEP] and sim.time(s) == row[L.M_STEP]
+            if row[L.M_SWEPT] != 0.0:  # a contact within the step: the row holds its own moment's poses
+                assert (row[L.M_STEP] - 1) * sim.dt < row[L.M_TC] <= row[L.M_STEP] * sim.dt + 1e-12
+                break
             assert (s[L.S_X], s[L.S_Y], s[L.S_HEADING], s[L.S_FWD], s[L.S_LAT]) == \
                 (row[L.M_X], row[L.M_Y], row[L.M_HEADING], row[L.M_FWD], row[L.M_LAT])
             if len(rows) < P.spa:
