@@ -100,21 +100,21 @@ def check_out_dir(out: str) -> Path:
 JUNIT_HELP = "Also write a JUnit XML test report (for CI) to this file (docs/ci.md)."
 
 
-def check_junit_path(junit: str | None) -> Path | None:
-    """The --junit file, its folder made if needed; exit 2 when it cannot be written there (checked before the
-    work, so that a long search does not end in an error)."""
+def check_junit_path(junit: str | None, flag: str = "--junit") -> Path | None:
+    """The --junit file (or another output file's, named by ``flag``), its folder made if needed; exit 2 when it
+    cannot be written there (checked before the work, so that a long search does not end in an error)."""
     if junit is None:
         return None
     path = Path(junit).expanduser()
     if path.is_dir():
-        raise fail(f"--junit {junit}: is a directory (give a file name)")
+        raise fail(f"{flag} {junit}: is a directory (give a file name)")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, probe = tempfile.mkstemp(prefix=".write-test-", dir=path.parent)
         os.close(fd)
         os.unlink(probe)
     except OSError as exc:
-        raise fail(f"--junit {junit}: cannot write in its folder ({exc.strerror or exc})") from None
+        raise fail(f"{flag} {junit}: cannot write in its folder ({exc.strerror or exc})") from None
     return path
 
 

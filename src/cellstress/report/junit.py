@@ -98,8 +98,9 @@ def check_suite(cell: str, rows) -> Suite:
                        for r in rows))
 
 
-def _class_words(k) -> str:
-    """A hazard class in words: the safeguard that failed, robot link / body region, where the worker stood."""
+def class_words(k) -> str:
+    """A hazard class (a result file's ``HazardClass`` or ``analysis.cell_diff.ClassKey``) in words: the safeguard
+    that failed, robot link / body region, where the worker stood."""
     x0, y0, x1, y1 = k.approach_cell
     failed = "no device saw the worker" if k.device == "none" else f"{k.device} stopped the robot too late"
     move = "" if k.robot_move is None else f", robot's move {k.robot_move}"
@@ -119,7 +120,7 @@ def search_suite(result) -> Suite:
     name = f"cellstress search {result.cell.name} ({result.searcher}, seed {result.seed}, budget {result.budget})"
     if result.distinct:
         return Suite(name, tuple(Case(class_name(d.klass), "search.hazard-class", FAILED,
-                                      f"episode {d.episode}: {_class_words(d.klass)}",
+                                      f"episode {d.episode}: {class_words(d.klass)}",
                                       f"actions: {', '.join(d.actions)}") for d in result.distinct))
     h = result.hazard
     if h is not None:
@@ -140,7 +141,7 @@ def verify_suite(res) -> Suite:
                   res.scope.statement if from_verdict == PASSED else "")]
     for w in res.classes:
         cases.append(Case(class_name(w.klass), "verify.witness", FAILED,
-                          f"{w.sequences:,} sequences: {_class_words(w.klass)}",
+                          f"{w.sequences:,} sequences: {class_words(w.klass)}",
                           f"first at {w.start}, phase {w.phase:g} s: {', '.join(w.actions)}; witness {w.file}"))
     return Suite(f"cellstress verify {res.cell.name} (horizon {res.options.horizon}, phases {res.options.phases})",
                  tuple(cases))
