@@ -6,23 +6,37 @@ from typing import Annotated
 
 import typer
 
-from cellstress.cli.common import CELL_HELP, first_sentence, num, say, spinner_while_compiling, user_errors
+from cellstress.cli.common import (
+    CELL_HELP,
+    JUNIT_HELP,
+    check_junit_path,
+    first_sentence,
+    num,
+    say,
+    spinner_while_compiling,
+    user_errors,
+    write_junit_file,
+)
 
 
 def check(
     cell: Annotated[str, typer.Argument(help=CELL_HELP)],
+    junit: Annotated[str | None, typer.Option("--junit", help=JUNIT_HELP + " One test case per check row.")] = None,
 ) -> None:
     """Validate a cell file, print a summary of it and run the static ISO 13855 / ISO 13857 check.
 
     Exit code 0 if the static check passes, 1 if it fails (a gate for a design in CI), 2 for a file that is not
     a valid cell."""
+    from cellstress.analysis.check_rows import check_rows
     from cellstress.analysis.iso13855 import check_cell
     from cellstress.analysis.program_check import check_programs
     from cellstress.analysis.robot_audit import audit_robot
     from cellstress.cell.load import BUILTIN_CELLS, builtin_file, load_cell
+    from cellstress.report.junit import check_suite
     from cellstress.robot.geometry import robot_geometry
     from cellstress.sim.build import build_layout
 
+    junit_path = check_junit_path(junit)
     with spinner_while_compiling(), user_errors():
         c = load_cell(cell)
         spec = c.spec
@@ -68,6 +82,7 @@ def check(
     for line in static.lines():
         out(f"  {line}")
     failures = [f for p in programs for f in p.failures()] + static.failures()
+    write_junit_file(junit_path, [check_suite(spec.name, check_rows(static, programs))])
     if not failures:
         out("PASS: the cell file is valid and the static check passes")
     else:

@@ -97,6 +97,39 @@ def check_out_dir(out: str) -> Path:
     return path
 
 
+JUNIT_HELP = "Also write a JUnit XML test report (for CI) to this file (docs/ci.md)."
+
+
+def check_junit_path(junit: str | None, flag: str = "--junit") -> Path | None:
+    """The --junit file (or another output file's, named by ``flag``), its folder made if needed; exit 2 when it
+    cannot be written there (checked before the work, so that a long search does not end in an error)."""
+    if junit is None:
+        return None
+    path = Path(junit).expanduser()
+    if path.is_dir():
+        raise fail(f"{flag} {junit}: is a directory (give a file name)")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, probe = tempfile.mkstemp(prefix=".write-test-", dir=path.parent)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise fail(f"{flag} {junit}: cannot write in its folder ({exc.strerror or exc})") from None
+    return path
+
+
+def write_junit_file(path: Path | None, suites) -> None:
+    """Write the JUnit report (nothing without --junit); exit 2 when the write fails."""
+    if path is None:
+        return
+    from cellstress.report.junit import write_junit
+
+    try:
+        write_junit(path, suites)
+    except OSError as exc:
+        raise fail(f"--junit {path}: cannot write ({exc.strerror or exc})") from None
+
+
 HEADER = (f"{'step':>4} {'t[s]':>6} {'x[m]':>7} {'y[m]':>7} {'head[deg]':>9} {'fwd[deg]':>8} "
           f"{'lat[deg]':>8} {'d_HR[m]':>8} {'v_R[m/s]':>8}  {'phase':<12} {'action':<26} devices")
 

@@ -10,13 +10,16 @@ from cellstress.cli.common import (
     CELL_HELP,
     COMPILING,
     INTERRUPTED,
+    JUNIT_HELP,
     check_criterion,
+    check_junit_path,
     check_out_dir,
     criterion_help,
     fail,
     num,
     say,
     user_errors,
+    write_junit_file,
 )
 from cellstress.core.errors import CellstressError
 
@@ -62,6 +65,9 @@ def search(
     settings: Annotated[list[str] | None, typer.Option("--set", help="Any other option of the searcher, "
                                                        "NAME=VALUE, repeated (e.g. --set pool=5 --set "
                                                        "score=risk for evolve; its docstring lists them).")] = None,
+    junit: Annotated[str | None, typer.Option("--junit", help=JUNIT_HELP + " One failing test case per hazard "
+                                              "class (--distinct) or for the hazard found, else one passing case.")]
+        = None,
 ) -> None:
     """Search a cell for a sequence of worker actions that ends in an unsafe contact; write result.json
     and its report (see 'cellstress report')."""
@@ -75,6 +81,7 @@ def search(
     from cellstress.cell.load import load_cell, with_criterion
     from cellstress.cli.report import after_search
     from cellstress.criteria.iso15066 import CREEP_SPEED
+    from cellstress.report.junit import search_suite
     from cellstress.report.scope import NOT_A_PROOF, judged_by, search_scope, strongest_contact
     from cellstress.searchers import make_searcher, parse_options
     from cellstress.searchers import search as run
@@ -97,6 +104,7 @@ def search(
         if distinct and until != "budget":
             raise CellstressError("--distinct needs --until budget")
     out_dir = check_out_dir(out)
+    junit_path = check_junit_path(junit)
 
     console = Console(stderr=True)
     progress = Progress(SpinnerColumn(), TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
@@ -135,6 +143,7 @@ def search(
         path = result.write(out_dir)
     except OSError as exc:
         raise fail(f"--out {out}: cannot write result.json ({exc.strerror or exc})") from None
+    write_junit_file(junit_path, [search_suite(result)])
     if compiled >= 1.0:
         say(f"compiled  the simulator's kernels in {compiled:.0f} s (once: numba keeps them in its cache)", err=True)
     rate = result.episodes / max(elapsed, 1e-9)

@@ -9,11 +9,14 @@ import typer
 from cellstress.cli.common import (
     CELL_HELP,
     INTERRUPTED,
+    JUNIT_HELP,
     check_criterion,
+    check_junit_path,
     check_out_dir,
     criterion_help,
     say,
     user_errors,
+    write_junit_file,
 )
 
 
@@ -34,6 +37,8 @@ def verify(
     workers: Annotated[int | None, typer.Option("--workers", help="Processes deciding sub-trees in parallel "
                                                 "(default: all usable cores; at most 4 per core).")] = None,
     criterion: Annotated[str | None, typer.Option("--criterion", help=criterion_help("the cell file's"))] = None,
+    junit: Annotated[str | None, typer.Option("--junit", help=JUNIT_HELP + " A test case for the verdict and a "
+                                              "failing one per hazard class.")] = None,
 ) -> None:
     """Decide exactly whether any sequence of the worker's actions reaches the unsafe set: every sequence, from
     every start point, at every arrival phase of the robot's cycle (a proof within the model, not a search).
@@ -47,6 +52,7 @@ def verify(
 
     from cellstress.cell.load import load_cell, with_criterion
     from cellstress.core.cpus import check_workers, usable_cpus
+    from cellstress.report.junit import verify_suite
     from cellstress.report.scope import judged_by
     from cellstress.report.verify import HTML_NAME, PNG_NAME, hazard_map, summary_lines, verify_page, witness_view
     from cellstress.sim.simulator import Simulator
@@ -56,6 +62,7 @@ def verify(
         check_criterion(criterion)
         check_workers(workers)
     out_dir = check_out_dir(out)
+    junit_path = check_junit_path(junit)
     console = Console(stderr=True)
     bar = Progress(SpinnerColumn(), TextColumn("[bold]deciding"), BarColumn(),
                    TextColumn("{task.percentage:>5.1f} % of {task.fields[of]} sequences"), TimeElapsedColumn(),
@@ -76,6 +83,7 @@ def verify(
         say("interrupted: nothing was decided (run the same command again)", err=True)
         raise typer.Exit(INTERRUPTED) from None
     elapsed = time.perf_counter() - t0
+    write_junit_file(junit_path, [verify_suite(res)])
     png = hazard_map(res, out_dir / PNG_NAME)
     page = verify_page(res, png, out_dir / HTML_NAME, judged_by(sim.criterion), witness_view(res, sim))
     for line in summary_lines(res, judged_by(sim.criterion), str(out_dir)):

@@ -44,6 +44,23 @@ def for_plot(text: str) -> str:
     return for_terminal(text).replace("$", r"\$")
 
 
+# XML 1.0 allows no C0 control but tab, line feed and carriage return, no lone surrogate and neither U+FFFE nor
+# U+FFFF (a parser refuses the whole file); C1 controls and bidirectional overrides are allowed but would mislead
+# a reader of a CI page as they would a terminal.
+_NOT_FOR_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069\ud800-\udfff\ufffe\uffff]")
+
+
+def for_xml(text: str, *, attribute: bool = False) -> str:
+    """XML text or (``attribute``) a double-quoted attribute value: ``& < > " '`` as entities (so ``]]>`` cannot
+    end anything), characters XML does not allow or a reader should not obey shown as ``\\x01``-style escapes,
+    and in an attribute tab and line breaks as character references (a parser would turn them into spaces)."""
+    text = _NOT_FOR_XML.sub(lambda m: m.group().encode("unicode_escape", "backslashreplace").decode("ascii"), str(text))
+    text = html.escape(text, quote=True)
+    if attribute:
+        text = text.replace("\t", "&#9;").replace("\n", "&#10;").replace("\r", "&#13;")
+    return text
+
+
 _UNSAFE_IN_FILE_NAME = re.compile(r"[^A-Za-z0-9._-]+")
 MAX_SLUG = 80
 

@@ -10,9 +10,13 @@
   the horizon.
 * **terminated** when the episode reaches the unsafe set; **truncated** after ``actions_per_episode`` actions.
 * **info**: ``d_HR``, ``v_R``, ``risk``, ``stop_phase``, ``devices`` (the devices that see the worker),
-  ``unsafe``.
+  ``unsafe``, and ``arrival``: the robot's path time [s] at the worker's arrival.
+* **Arrival** (``human.arrival``): ``fixed`` arrives at the cell's phase (or the start point's) every episode;
+  ``cycle`` or a window draws the arrival moment at each ``reset`` from the moments a search chooses from
+  (``sim.starts.arrival_phases``: the time steps of the cycle or the window), uniformly, with the env's
+  ``np_random``, so the same reset seed gives the same moment.
 
-The env is deterministic: ``reset``'s seed changes nothing (there is no randomness to seed), so
+The env is deterministic given the reset's seed (with ``arrival: fixed`` the seed changes nothing), so
 ``gymnasium.utils.env_checker.check_env`` passes. ``CellVectorEnv`` steps ``num_envs`` copies with one call of
 the simulator's batched step (``Simulator.step_many``); finished copies reset themselves on the next step
 (Gymnasium's next-step autoreset).
@@ -31,28 +35,59 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from cellstress.cell.load import Cell, load_cell, with_criterion
 from cellstress.sim import layout as L
 from cellstress.sim.simulator import STOP_PHASES, Simulator
-from cellstress.sim.starts import start_simulator
+from cellstress.sim.starts import arrival_phases, start_simulator
 
 N_OBS = 11
+
+
+def _start(c: Cell, start: str | None):
+    """The ``human.starts`` entry named ``start`` (None: the cell's ``human.start``)."""
+    if start is None:
+        return None
+    for s in c.spec.human.starts:
+        if s.name == start:
+            return s
+    known = ", ".join(s.name for s in c.spec.human.starts) or "none"
+    raise ValueError(f"unknown start {start!r} (the cell's starts: {known})")
 
 
 def _simulator(cell: str | Path | Cell, criterion: str | None, start: str | None) -> Simulator:
     c = cell if isinstance(cell, Cell) else load_cell(cell)
     sim = Simulator(with_criterion(c, criterion))
-    if start is None:
+    s = _start(c, start)
+    return sim if s is None else start_simulator(sim, s)
+
+
+class Arrivals:
+    """The simulators of a cell at each arrival moment ``reset`` may draw (made when first drawn, then kept)."""
+
+    def __init__(self, cell: str | Path | Cell, criterion: str | None, start: str | None):
+        c = cell if isinstance(cell, Cell) else load_cell(cell)
+        self.base = Simulator(with_criterion(c, criterion))
+        self.start = _start(c, start)
+        self.fixed = c.spec.human.arrival == "fixed"
+        self.default = self.base if self.start is None else start_simulator(self.base, self.start)
+        self.phases = (self.default.phase,) if self.fixed else arrival_phases(self.base, self.start)
+        self._sims: dict[float, Simulator] = {}
+
+    def draw(self, rng: np.random.Generator) -> Simulator:
+        """The default simulator (``arrival: fixed``), else the one at a moment drawn uniformly by ``rng``."""
+        if self.fixed:
+            return self.default
+        phase = self.phases[int(rng.integers(len(self.phases)))]
+        sim = self._sims.get(phase)
+        if sim is None:
+            sim = self._sims[phase] = start_simulator(self.base, self.start, phase) if self.start is not None \
+                else self.base.with_start(self.base.start, phase)
         return sim
-    for s in c.spec.human.starts:
-        if s.name == start:
-            return start_simulator(sim, s)
-    known = ", ".join(s.name for s in c.spec.human.starts) or "none"
-    raise ValueError(f"unknown start {start!r} (the cell's starts: {known})")
 
 
-def observation_space(sim: Simulator) -> spaces.Box:
+def observation_space(sim: Simulator, latest_phase: float | None = None) -> spaces.Box:
     """The bounds of every observation of this cell (see the module docstring). d_HR and v_R get sound bounds:
     no robot point is further from the base than the chain's length L (joint offsets and capsule ends), so
     d_HR <= the floor's diagonal + |base to floor| + L, and v_R <= L times the sum of the joint speed limits
-    (the path never exceeds a joint's limit)."""
+    (the path never exceeds a joint's limit). ``latest_phase``: the latest arrival moment reset may draw (the
+    path time's bound; default the simulator's own phase)."""
     fl, hs, lay = sim.cell.spec.floor, sim.cell.spec.human, sim.layout
     t_max = sim.dt * sim.steps_per_action * sim.actions_per_episode
     fwd, lat = np.deg2rad(hs.max_forward_flexion_deg), np.deg2rad(hs.max_lateral_flexion_deg)
@@ -65,7 +100,8 @@ def observation_space(sim: Simulator) -> spaces.Box:
     d_max = float(np.hypot(corner, abs(bz) + 3.0) + reach)
     v_max = float(reach * np.abs(lay.robot.velocity_limits).sum())
     low = np.array([0.0, fl.xmin, fl.ymin, -1.0, -1.0, 0.0, -lat, 0.0, 0.0, 0.0, 0.0])
-    high = np.array([t_max, fl.xmax, fl.ymax, 1.0, 1.0, fwd, lat, 3.0, d_max, v_max, sim.phase + t_max])
+    last = sim.phase if latest_phase is None else latest_phase
+    high = np.array([t_max, fl.xmax, fl.ymax, 1.0, 1.0, fwd, lat, 3.0, d_max, v_max, last + t_max])
     if sim.layout.worker.articulated:  # its stance [m] and arm joints [rad] (human.reach's ranges lie within)
         low = np.r_[low, -lay.body.height, np.full(10, -np.pi)]
         high = np.r_[high, 0.5, np.full(10, np.pi)]
@@ -88,16 +124,18 @@ class CellEnv(gymnasium.Env):
 
     def __init__(self, cell: str | Path | Cell = "baseline", criterion: str | None = None,
                  start: str | None = None):
-        self.sim = _simulator(cell, criterion, start)
+        self.arrivals = Arrivals(cell, criterion, start)
+        self.sim = self.arrivals.default
         self._limbs = self.sim.layout.worker.articulated
         self.action_space = spaces.Discrete(self.sim.n_actions)
-        self.observation_space = observation_space(self.sim)
+        self.observation_space = observation_space(self.sim, max(self.arrivals.phases))
         self.reward_of = self.sim.criterion.reward(self.sim.actions_per_episode)
         self._state = self.sim.reset()
         self._played = 0
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
+        self.sim = self.arrivals.draw(self.np_random)
         self._state = self.sim.reset()
         self._played = 0
         row = self.sim.initial_metrics()
@@ -119,11 +157,14 @@ class CellEnv(gymnasium.Env):
         seen = int(row[L.M_SEEN])
         return {"d_HR": float(row[L.M_D]), "v_R": float(row[L.M_V]), "risk": float(risk),
                 "stop_phase": STOP_PHASES[int(row[L.M_PHASE])], "unsafe": bool(row[L.M_UNSAFE]),
-                "devices": [n for i, n in enumerate(self.sim.layout.device_names) if seen >> i & 1]}
+                "devices": [n for i, n in enumerate(self.sim.layout.device_names) if seen >> i & 1],
+                "arrival": float(self.sim.phase)}
 
 
 class CellVectorEnv(VectorEnv):
-    """``num_envs`` copies of a cell, stepped together (see the module docstring)."""
+    """``num_envs`` copies of a cell, stepped together (see the module docstring). Every copy arrives at the
+    cell's own moment (its phase), also where the cell says ``arrival: cycle``: copies at different moments would
+    need a simulator each, not one batched step."""
 
     metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
 
