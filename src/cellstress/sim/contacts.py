@@ -25,6 +25,7 @@ from cellstress.sim import clamping, scene
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 from cellstress.sim.build import Layout
+from cellstress.sim.kernels.params import SWEEP_CERTIFIED, SWEEP_DEPTH
 
 
 def at_contact(row: np.ndarray, dt: float) -> tuple[np.ndarray, float]:
@@ -32,12 +33,12 @@ def at_contact(row: np.ndarray, dt: float) -> tuple[np.ndarray, float]:
     found between two steps (``M_SWEPT`` 1 or 2) holds the robot and the worker as posed at ``M_TC``, while
     ``M_T`` is the step's time: the robot's time scaling and the worker's speed (the worker moves at a constant
     velocity within a step, ``kernels.sweep``) are taken at ``M_TC``. The time since the step before is kept
-    above 1/256 of a step (the finest part the swept test halves a step into)."""
+    above the finest part the swept test halves a step into."""
     if row[L.M_SWEPT] == 0.0 or not row[L.M_TC] >= 0.0:
         return row, dt
     at = np.array(row, dtype=float)
     at[L.M_T] = row[L.M_TC]
-    return at, max(float(row[L.M_TC]) - (float(row[L.M_T]) - dt), dt / 256.0)
+    return at, max(float(row[L.M_TC]) - (float(row[L.M_T]) - dt), dt / 2 ** (SWEEP_DEPTH + SWEEP_CERTIFIED))
 
 
 class ContactModel:

@@ -11,7 +11,7 @@ from cellstress.core.jit import njit
 from cellstress.sim.layout import MAX_CAPSULES, NM, NS
 
 SWEEP_DEPTH = 5  # the swept test halves a step this often on separation's values (1/32 of a step)
-SWEEP_CERTIFIED = 3  # then this often more on certified lower bounds (1/256 of a step)
+SWEEP_CERTIFIED = 5  # then this often more on certified lower bounds (1/1024 of a step)
 SWEEP_STACK = SWEEP_DEPTH + SWEEP_CERTIFIED + 2  # intervals waiting at most: one per level, and one being split
 
 

@@ -95,7 +95,7 @@ from cellstress.sim.layout import (
 )
 
 REACH_SLOPE = np.sqrt(3.0)  # the reach field's largest slope (a trilinear interpolant of a 1-Lipschitz grid)
-CERT_STEP = 0.002  # m between the samples of a robot capsule's axis in a certified lower bound
+CERT_STEP = 0.001  # m between the samples of a robot capsule's axis in a certified lower bound
 
 
 @njit(cache=True, error_model="numpy", inline="always")
