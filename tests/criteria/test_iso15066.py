@@ -229,8 +229,9 @@ def test_contact_point_velocity_matches_the_kernel_kinematics():
 
 def test_a_criterion_step_inside_an_action_leaves_the_state_of_that_step():
     """When the criterion ends the episode before an action's last 50 ms step, Simulator.step returns the state
-    of that step: its clock and pose are the unsafe row's (a contact within the step: its moment lies in it), and measuring it again (the kernel's own
-    sense_and_measure, which also latches stops) reproduces that row and latches nothing new."""
+    of that step: its clock and pose are the unsafe row's (a contact within the step: its moment lies in it),
+    and measuring it again (the kernel's own sense_and_measure, which also latches stops) reproduces that row
+    and latches nothing new."""
     sim = _strict_s3()
     P = sim.params
     rng = np.random.default_rng(11)
