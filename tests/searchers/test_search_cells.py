@@ -42,8 +42,11 @@ def test_searchers_find_the_hazard(sims, cell, searcher, tmp_path, capsys) -> No
     assert 1 <= len(h.actions) <= sim.actions_per_episode
     last = h.trace[-1]
     assert last.unsafe and not any(r.unsafe for r in h.trace[:-1])
-    assert h.d_HR == last.d_HR <= 0.0 and h.v_R == last.v_R > 0.001
-    assert h.step == last.step and h.time_s == last.t
+    # a contact at the step, or one the swept test found (or could not rule out) between the steps, at its moment
+    assert h.d_HR == last.d_HR and (last.d_HR <= 0.0 or last.between == "not-ruled-out")
+    assert h.v_R == last.v_R > 0.001
+    assert h.step == last.step and h.time_s == (last.t if last.between is None else last.contact_t)
+    assert last.between is None or last.t - 0.05 < last.contact_t <= last.t
     assert (h.robot_link, h.body_part, h.point) == (last.robot_link, last.body_part,
                                                             last.robot_point)
     # the episode's risk (max 1/c_S over its action ends) is at least that of the contact, e^{v_R}

@@ -258,6 +258,7 @@ class _Model:
             phase = phases[r]
             upto = int(braking[r][0]) if len(braking[r]) else len(rows)
             keep = (phase[:upto] <= L.PHASE_PENDING) | (phase[:upto] == L.PHASE_REDUCED)
+            keep &= rows[:upto, L.M_SWEPT] == 0.0  # a contact between the steps holds the robot at its own moment
             if self.n_robots > 1:
                 keep &= rows[:upto, L.M_ROBOT] == r
             on_path = rows[:upto][keep]

@@ -144,7 +144,8 @@ def explain(layout, records, unsafe_row: int) -> Why:
     timings = tuple(DeviceTiming.model_construct(
         device=d.name, saw_at_s=saw.get(d.name),
         stop_at_s=None if d.name not in saw else _r(saw[d.name] + response[d.name])) for d in spec.devices)
-    contact = records[unsafe_row].t
+    hit = records[unsafe_row]
+    contact = hit.t if hit.contact_t is None else hit.contact_t  # a contact between the steps: its own moment
     stops = [t for t in timings if t.stop_at_s is not None and t.device in stopping]
     if not stops:
         return Why.model_construct(detected=False, devices=timings, stopped_by=None, braking_from_s=None,

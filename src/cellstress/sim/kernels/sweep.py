@@ -78,6 +78,7 @@ from cellstress.sim.layout import (
     M_X,
     M_Y,
     N_BODY_CAPSULES,
+    PHASE_BRAKING,
     PHASE_STOPPED,
     S_A_T,
     S_D_SEP,
@@ -194,7 +195,8 @@ def _worker_travel(P, prev, state):
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def _sample(P, prev, state, W, s, t0, out):
     """d_HR at fraction s of the step (worker and robots posed then) into out (a metric row's fields D, LINK,
-    PART, the points, V, ROBOT, TAU, PHASE and the pose); returns (separation's value, moving, contact time)."""
+    PART, the points, V, ROBOT, TAU, PHASE and the pose); returns (separation's value, moving, contact time,
+    slowing: the nearest robot is braking or stopped)."""
     scal = P.scal
     dt = scal[C_DT]
     t = t0 + s * dt
@@ -241,7 +243,7 @@ def _sample(P, prev, state, W, s, t0, out):
     out[M_X], out[M_Y], out[M_HEADING], out[M_FWD], out[M_LAT] = x, y, h, f, lt
     for i in range(11):
         out[M_DROP + i] = ext[i]
-    return d, moving, t
+    return d, moving, t, ph == PHASE_BRAKING or ph == PHASE_STOPPED
 
 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
@@ -349,11 +351,16 @@ def sweep_step(P, prev, state, W, row):
         if near > dtol:
             continue
         if depth >= SWEEP_DEPTH + SWEEP_CERTIFIED:
-            if not judged:  # cannot be cleared at the finest sub-step: a contact, conservatively
+            if not judged:  # cannot be cleared at the finest sub-step: a contact, conservatively, unless the
+                # robot is slowing and not moving at the part's start: braking, its speed only falls (to within
+                # the path's curvature over the part's 0.05 ms), and a stopped robot stays stopped
+                _, moving_a, _, slowing_a = _sample(P, prev, state, W, sa, t0, W.srow)
+                if slowing_a and not moving_a:
+                    continue
                 found_t = ta
                 found = 2
                 # the nearer end's pose for the row, with that end's own moment (the contact's time in M_TC)
-                _, _, t_end = _sample(P, prev, state, W, sa if da <= db else sb, t0, W.srow)
+                _, _, t_end, _ = _sample(P, prev, state, W, sa if da <= db else sb, t0, W.srow)
                 _copy_contact(W.srow, W.crow, t_end, 2.0)
             continue
         if depth >= SWEEP_DEPTH and cert == 0.0:  # go on with certified lower bounds at both ends
@@ -363,7 +370,7 @@ def sweep_step(P, prev, state, W, row):
             db = _certified(P, W)
             cert = 1.0
         sm = 0.5 * (sa + sb)
-        dm, moving, tm = _sample(P, prev, state, W, sm, t0, W.srow)
+        dm, moving, tm, _ = _sample(P, prev, state, W, sm, t0, W.srow)
         if dm <= dtol and (moving or judged) and tm < found_t:
             found_t = tm
             found = 1
