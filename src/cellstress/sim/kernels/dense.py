@@ -10,7 +10,7 @@ import numpy as np
 from cellstress.core.jit import njit, prange
 from cellstress.sim.kernels.params import make_work
 from cellstress.sim.kernels.step import begin_action, move_worker, sense_and_measure
-from cellstress.sim.kernels.sweep import _sample
+from cellstress.sim.kernels.sweep import _possible, _sample
 from cellstress.sim.layout import C_DT, C_DTOL, NM, NS, S_FWD, S_HEADING, S_K, S_LAT
 
 
@@ -18,9 +18,10 @@ from cellstress.sim.layout import C_DT, C_DTOL, NM, NS, S_FWD, S_HEADING, S_K, S
 def dense_episode(P, s0, actions, n_sub):
     """The first step of the episode ``actions`` (played from s0 with ``P``'s swept test off) at which the kernel
     test holds at the step's sample or at one of the ``n_sub - 1`` moments evenly between it and the previous
-    step; -1: none. Its own kernel, not inlined into ``dense_batch``'s parallel loop: compiled there (the step's
-    inlined functions under the parallel transforms), it reported contacts the same code called step by step
-    does not (reach-over, numba 0.68), as ``batch.run_batch`` keeps ``step_action`` apart too."""
+    step, in a pose the worker can be in (``sweep._possible``); -1: none. Its own kernel, not inlined into
+    ``dense_batch``'s parallel loop: compiled there (the step's inlined functions under the parallel
+    transforms), it reported contacts the same code called step by step does not (reach-over, numba 0.68), as
+    ``batch.run_batch`` keeps ``step_action`` apart too."""
     spa = P.spa
     dt = P.scal[C_DT]
     W = make_work(P)
@@ -43,7 +44,7 @@ def dense_episode(P, s0, actions, n_sub):
                 if unsafe:
                     break
                 d, moving, _, _ = _sample(P, prev, state, W, m / n_sub, t0, srow)
-                unsafe = d <= P.scal[C_DTOL] and moving
+                unsafe = d <= P.scal[C_DTOL] and moving and _possible(P, W)
             if unsafe:
                 return int(state[S_K])
     return -1

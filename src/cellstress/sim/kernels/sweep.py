@@ -36,6 +36,7 @@ from cellstress.sim.kernels.fences import blocking_panel, collect_near_fences, f
 from cellstress.sim.kernels.params import SWEEP_CERTIFIED, SWEEP_DEPTH
 from cellstress.sim.kernels.reach import TRACE_REL_TOL, reach_field_at
 from cellstress.sim.kernels.robot import _robot_live, _segment, live_path_time, path_time
+from cellstress.sim.kernels.sensing import body_blocked
 from cellstress.sim.kernels.separation import separation
 from cellstress.sim.layout import (
     A_DROP,
@@ -246,6 +247,16 @@ def _sample(P, prev, state, W, s, t0, out):
     return d, moving, t, ph == PHASE_BRAKING or ph == PHASE_STOPPED
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _possible(P, W):
+    """Whether the worker can be in the pose ``_sample`` left in W: no body part through a fence panel or into an
+    obstacle (``sensing.body_blocked``, the test every step's end pose passes). The straight line between two
+    allowed poses can cross a panel (a bent trunk turning beside a wall swings a shoulder through it, and the
+    reach volumes hanging on it reach round the panel for free); the worker cannot be there, so no contact
+    counts from there."""
+    return body_blocked(P.body, W.fences, P.obs_verts, P.obs_poly, P.obs_box, W.ha, W.hb, W.hr) == 0
+
+
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def _certified(P, W):
     """A lower bound on the distance between the robot and the worker as posed in W (by ``_sample``): body
@@ -357,6 +368,10 @@ def sweep_step(P, prev, state, W, row):
                 _, moving_a, _, slowing_a = _sample(P, prev, state, W, sa, t0, W.srow)
                 if slowing_a and not moving_a:
                     continue
+                if not _possible(P, W):  # (a part of 0.05 ms whose both ends the worker cannot be in)
+                    _sample(P, prev, state, W, sb, t0, W.srow)
+                    if not _possible(P, W):
+                        continue
                 found_t = ta
                 found = 2
                 # the nearer end's pose for the row, with that end's own moment (the contact's time in M_TC)
@@ -371,7 +386,7 @@ def sweep_step(P, prev, state, W, row):
             cert = 1.0
         sm = 0.5 * (sa + sb)
         dm, moving, tm, _ = _sample(P, prev, state, W, sm, t0, W.srow)
-        if dm <= dtol and (moving or judged) and tm < found_t:
+        if dm <= dtol and (moving or judged) and tm < found_t and _possible(P, W):
             found_t = tm
             found = 1
             _copy_contact(W.srow, W.crow, tm, 1.0)
