@@ -368,14 +368,18 @@ def sweep_step(P, prev, state, W, row):
                 _, moving_a, _, slowing_a = _sample(P, prev, state, W, sa, t0, W.srow)
                 if slowing_a and not moving_a:
                     continue
-                if not _possible(P, W):  # (a part of 0.05 ms whose both ends the worker cannot be in)
-                    _sample(P, prev, state, W, sb, t0, W.srow)
-                    if not _possible(P, W):
-                        continue
+                possible_a = _possible(P, W)
+                _, moving_b, _, _ = _sample(P, prev, state, W, sb, t0, W.srow)
+                possible_b = _possible(P, W)
+                if not possible_a and not possible_b:
+                    continue  # (a part of 0.05 ms whose both ends the worker cannot be in)
                 found_t = ta
                 found = 2
-                # the nearer end's pose for the row, with that end's own moment (the contact's time in M_TC)
-                _, _, t_end, _ = _sample(P, prev, state, W, sa if da <= db else sb, t0, W.srow)
+                # the row: an end the worker can be in, where the robot moves if it moves at one end only (a
+                # dwell's end), else the nearer one; with that end's own moment (the contact's time in M_TC)
+                rank_a = 4 * possible_a + 2 * moving_a + (da <= db)
+                rank_b = 4 * possible_b + 2 * moving_b + (db < da)
+                _, _, t_end, _ = _sample(P, prev, state, W, sa if rank_a >= rank_b else sb, t0, W.srow)
                 _copy_contact(W.srow, W.crow, t_end, 2.0)
             continue
         if depth >= SWEEP_DEPTH and cert == 0.0:  # go on with certified lower bounds at both ends
