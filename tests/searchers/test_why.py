@@ -60,8 +60,9 @@ def test_timeline_agrees_with_the_trace(cell):
             assert hit.stop_phase == "running" and not any(r.devices for r in recs)
             continue
         # the stop the timeline names is the one the simulator applied
-        if braking:
-            assert braking[0] == pytest.approx(why.braking_from_s, abs=1e-9)
+        if braking:  # the first step sampled braking: at the moment braking begins, or the next step when that
+            # moment lies a float's rounding after its step (the sample there says "stop-pending")
+            assert why.braking_from_s - 1e-9 <= braking[0] < why.braking_from_s + sim.dt + 1e-9
         else:
             assert why.braking_from_s >= hit.t - 1e-9
         assert hit.stop_phase != "stopped" or why.late_by_s <= 1e-9
