@@ -43,7 +43,7 @@ def dense_episode(P, s0, actions, n_sub):
             for m in range(1, n_sub):
                 if unsafe:
                     break
-                d, moving, _, _ = _sample(P, prev, state, W, m / n_sub, t0, srow)
+                d, moving, _ = _sample(P, prev, state, W, m / n_sub, t0, srow)
                 unsafe = d <= P.scal[C_DTOL] and moving and _possible(P, W)
             if unsafe:
                 return int(state[S_K])

@@ -79,7 +79,6 @@ from cellstress.sim.layout import (
     M_X,
     M_Y,
     N_BODY_CAPSULES,
-    PHASE_BRAKING,
     PHASE_STOPPED,
     S_A_T,
     S_D_SEP,
@@ -196,8 +195,7 @@ def _worker_travel(P, prev, state):
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def _sample(P, prev, state, W, s, t0, out):
     """d_HR at fraction s of the step (worker and robots posed then) into out (a metric row's fields D, LINK,
-    PART, the points, V, ROBOT, TAU, PHASE and the pose); returns (separation's value, moving, contact time,
-    slowing: the nearest robot is braking or stopped)."""
+    PART, the points, V, ROBOT, TAU, PHASE and the pose); returns (separation's value, moving, contact time)."""
     scal = P.scal
     dt = scal[C_DT]
     t = t0 + s * dt
@@ -244,7 +242,7 @@ def _sample(P, prev, state, W, s, t0, out):
     out[M_X], out[M_Y], out[M_HEADING], out[M_FWD], out[M_LAT] = x, y, h, f, lt
     for i in range(11):
         out[M_DROP + i] = ext[i]
-    return d, moving, t, ph == PHASE_BRAKING or ph == PHASE_STOPPED
+    return d, moving, t
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -363,23 +361,21 @@ def sweep_step(P, prev, state, W, row):
             continue
         if depth >= SWEEP_DEPTH + SWEEP_CERTIFIED:
             if not judged:  # cannot be cleared at the finest sub-step: a contact, conservatively, unless the
-                # robot is slowing and not moving at the part's start: braking, its speed only falls (to within
-                # the path's curvature over the part's 0.05 ms), and a stopped robot stays stopped
-                _, moving_a, _, slowing_a = _sample(P, prev, state, W, sa, t0, W.srow)
-                if slowing_a and not moving_a:
-                    continue
+                # nearest robot moves at neither end (its speed taken as monotone over the part's 0.05 ms: braking
+                # it only falls, leaving a dwell it only rises) or the worker can be at neither end
+                _, moving_a, _ = _sample(P, prev, state, W, sa, t0, W.srow)
                 possible_a = _possible(P, W)
-                _, moving_b, _, _ = _sample(P, prev, state, W, sb, t0, W.srow)
+                _, moving_b, _ = _sample(P, prev, state, W, sb, t0, W.srow)
                 possible_b = _possible(P, W)
-                if not possible_a and not possible_b:
-                    continue  # (a part of 0.05 ms whose both ends the worker cannot be in)
+                if not (moving_a or moving_b) or not (possible_a or possible_b):
+                    continue
                 found_t = ta
                 found = 2
                 # the row: an end the worker can be in, where the robot moves if it moves at one end only (a
                 # dwell's end), else the nearer one; with that end's own moment (the contact's time in M_TC)
                 rank_a = 4 * possible_a + 2 * moving_a + (da <= db)
                 rank_b = 4 * possible_b + 2 * moving_b + (db < da)
-                _, _, t_end, _ = _sample(P, prev, state, W, sa if rank_a >= rank_b else sb, t0, W.srow)
+                _, _, t_end = _sample(P, prev, state, W, sa if rank_a >= rank_b else sb, t0, W.srow)
                 _copy_contact(W.srow, W.crow, t_end, 2.0)
             continue
         if depth >= SWEEP_DEPTH and cert == 0.0:  # go on with certified lower bounds at both ends
@@ -389,7 +385,7 @@ def sweep_step(P, prev, state, W, row):
             db = _certified(P, W)
             cert = 1.0
         sm = 0.5 * (sa + sb)
-        dm, moving, tm, _ = _sample(P, prev, state, W, sm, t0, W.srow)
+        dm, moving, tm = _sample(P, prev, state, W, sm, t0, W.srow)
         if dm <= dtol and (moving or judged) and tm < found_t and _possible(P, W):
             found_t = tm
             found = 1
