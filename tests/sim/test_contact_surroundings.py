@@ -14,7 +14,7 @@ from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 from cellstress.sim import scene
 from cellstress.sim.clamping import body_point_velocity, remaining_path_time, travel
-from cellstress.sim.contacts import at_contact
+from cellstress.sim.contacts import at_contact, step_end_pose
 from cellstress.sim.scene import time_scaling
 from cellstress.sim.simulator import Simulator
 
@@ -132,7 +132,8 @@ def test_contacts_carry_the_worker_speed_and_the_verdict_is_the_judged_one():
     assert part == L.PART_LEFT_REACH
     local = now.trunk.T @ (np.asarray(c.human_point) - now.shoulders[0])
     moved = np.asarray(c.human_point) - (before.shoulders[0] + before.trunk @ local)
-    assert c.v_human == pytest.approx(max(0.0, -float(n @ moved)) / sim.dt, rel=1e-9) and c.v_human > 0.0
+    elapsed = at_contact(row, sim.dt)[1]  # a whole step, or the part of it before a contact found within it
+    assert c.v_human == pytest.approx(max(0.0, -float(n @ moved)) / elapsed, rel=1e-9) and c.v_human > 0.0
     v = sim.verdict_at(trace, i)
     assert v.unsafe and v.v_human == pytest.approx(min(2.0, c.v_human))
     assert v.force == pytest.approx((c.v_rel + v.v_human) * math.sqrt(
@@ -151,14 +152,20 @@ def test_a_contact_between_the_steps_is_judged_at_its_own_moment():
     acts = ["walk+bend-right", "turn-left-45+bend-forward-left", "walk+bend-forward", "walk+bend-forward-left"]
     trace = sim.run(acts)
     i = trace.unsafe_row
-    row, prev = trace.rows[i], L.row_pose(trace.rows[i - 1])
+    row, prev = np.array(trace.rows[i]), L.row_pose(trace.rows[i - 1])
+    row[L.M_SWEPT], row[L.M_TC] = 0.0, row[L.M_T]  # (the same poses, as a contact at the step's own sample)
     whole = sim.contacts.contact(row, prev)
-    assert row[L.M_SWEPT] == 0.0 and whole.v_human > 0.0
+    assert whole.v_human > 0.0
     half = np.array(row)
     half[L.M_SWEPT], half[L.M_TC] = 1.0, row[L.M_T] - sim.dt / 2.0
     at, elapsed = at_contact(half, sim.dt)
     assert at[L.M_T] == half[L.M_TC] and elapsed == pytest.approx(sim.dt / 2.0, rel=1e-12)
     assert at_contact(row, sim.dt)[0] is row and at_contact(row, sim.dt)[1] == sim.dt
+    # the pose at the step's end: the line from the step's start through the contact's pose, continued
+    end = step_end_pose(half, prev, sim.dt)
+    assert end == pytest.approx(prev + 2.0 * (L.row_pose(half) - prev), abs=1e-12)
+    assert step_end_pose(row, prev, sim.dt) is not None and np.array_equal(step_end_pose(row, prev, sim.dt),
+                                                                              L.row_pose(row))
     assert sim.contacts.contact(half, prev).v_human == pytest.approx(2.0 * whole.v_human, rel=1e-9)
     # a step braking: the time scaling at the contact's own moment, not at the step's
     braking = np.array(row)

@@ -24,7 +24,7 @@ def _unswept(sim: Simulator) -> Simulator:
 @pytest.fixture(scope="module")
 def s3():
     sim = Simulator("s3-fence-gap")
-    acts = np.random.default_rng(0).integers(0, sim.n_actions, size=(1500, sim.actions_per_episode))
+    acts = np.random.default_rng(0).integers(0, sim.n_actions, size=(4000, sim.actions_per_episode))
     return sim, acts, sim.run_batch(acts).unsafe_step
 
 

@@ -41,6 +41,20 @@ def at_contact(row: np.ndarray, dt: float) -> tuple[np.ndarray, float]:
     return at, max(float(row[L.M_TC]) - (float(row[L.M_T]) - dt), dt / 2 ** (SWEEP_DEPTH + SWEEP_CERTIFIED))
 
 
+def step_end_pose(row: np.ndarray, start: np.ndarray, dt: float) -> np.ndarray:
+    """The worker's pose vector at the end of a row's step, from its pose at the step's start: the row's own pose,
+    or for a contact found within the step (whose row holds the contact moment's pose, ``at_contact``) the
+    straight line from the start through it, continued to the step's end (the worker moves on that line within
+    a step, ``kernels.sweep``). So the pose the next step starts from is known from the rows alone."""
+    if row[L.M_SWEPT] == 0.0 or not row[L.M_TC] >= 0.0:
+        return L.row_pose(row)
+    s = (float(row[L.M_TC]) - (float(row[L.M_T]) - dt)) / dt
+    if not s > 0.0:
+        return L.row_pose(row)
+    start = np.asarray(start, dtype=float)
+    return start + (L.row_pose(row) - start) / s
+
+
 class ContactModel:
     """Contacts of one simulator layout (pinocchio model and data made once, like the simulator's work arrays)."""
 

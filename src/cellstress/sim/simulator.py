@@ -23,7 +23,7 @@ from cellstress.human.body import BODY_PARTS
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 from cellstress.sim.build import Layout, build_layout, with_phase
-from cellstress.sim.contacts import ContactModel
+from cellstress.sim.contacts import ContactModel, step_end_pose
 from cellstress.sim.lookahead import Lookahead
 from cellstress.sim.records import STOP_PHASES, StepRecord
 from cellstress.sim.starts import is_arrival_token, split_start
@@ -234,10 +234,11 @@ class Simulator:
         worker's pose vector one step before ``rows[0]`` (the state the rows were played from), for the worker's
         speed at a contact in the first row."""
         tol = self.criterion.distance_tolerance
-        for i in np.flatnonzero(rows[:, L.M_D] <= tol):
-            prev = before if i == 0 else L.row_pose(rows[i - 1])
-            if self.criterion.judge(self.contacts.contact(rows[i], prev)).unsafe:
-                return int(i)
+        start = before  # the worker's pose at the start of row i's step
+        for i in range(len(rows)):
+            if rows[i, L.M_D] <= tol and self.criterion.judge(self.contacts.contact(rows[i], start)).unsafe:
+                return i
+            start = L.row_pose(rows[i]) if start is None else step_end_pose(rows[i], start, self.dt)
         return None
 
     def verdict(self, row: np.ndarray, prev: np.ndarray | None = None):
@@ -250,8 +251,15 @@ class Simulator:
         return self.criterion.judge(self.contacts.contact(row, None if prev is None else L.row_pose(prev)))
 
     def verdict_at(self, trace: Trace, i: int):
-        """The verdict on row ``i`` of ``trace`` (``verdict`` with the row before it)."""
-        return self.verdict(trace.rows[i], trace.rows[i - 1] if i > 0 else None)
+        """The verdict on row ``i`` of ``trace``, with the worker's pose at the start of its step as ``first_unsafe``
+        has it (a row before it that holds a contact within its step holds that moment's pose, not its step's
+        end: ``contacts.step_end_pose``), so that the verdict is the one the simulator judged."""
+        if self.contacts is None:
+            return None
+        start = None
+        for j in range(i):
+            start = L.row_pose(trace.rows[j]) if start is None else step_end_pose(trace.rows[j], start, self.dt)
+        return self.criterion.judge(self.contacts.contact(trace.rows[i], start))
 
     def measures(self, rows: np.ndarray) -> Measures:
         """What the reward sees of an action: d_HR and v_R at its last step (and the criterion's severity there)."""
