@@ -414,15 +414,22 @@ def _action_array(actions, n_actions: int) -> np.ndarray:
 
 def _state_at(nxt: np.ndarray, before: np.ndarray, rows: np.ndarray, params) -> None:
     """Turn ``nxt``, the state at the end of an action played from ``before``, into the state at the step of
-    ``rows[-1]``, where a criterion ended the episode: the clock and pose from that row, and the latches (stops,
+    ``rows[-1]``, where a criterion ended the episode: the clock from that row, the pose at its step's end
+    (``contacts.step_end_pose``), and the latches (stops,
     speed reductions, releases) replayed from the devices each row saw, by the kernel's own code
     (``kernels.latch_seen``, as ``kernels.sense_and_measure`` latches them)."""
     row = rows[-1]
     nxt[L.S_K] = row[L.M_STEP]
-    nxt[L.S_X], nxt[L.S_Y], nxt[L.S_HEADING] = row[L.M_X], row[L.M_Y], row[L.M_HEADING]
-    nxt[L.S_FWD], nxt[L.S_LAT] = row[L.M_FWD], row[L.M_LAT]
     nxt[L.S_TSTOP], nxt[L.S_TRIG_DEV], nxt[L.S_TRIG_T] = before[L.S_TSTOP], before[L.S_TRIG_DEV], before[L.S_TRIG_T]
     nxt[L.S_LIVE:] = before[L.S_LIVE:]  # the safeguard slots, appended after ACTIONS
-    nxt[L.S_DROP:L.S_DROP + 11] = row[L.M_DROP:L.M_DROP + 11]  # the articulated worker's stance and arms
+    # the pose at the end of that step (a row holding a contact within its step holds that moment's pose)
+    dt = float(params.scal[L.C_DT])
+    pose = before[_POSE_STATE]
+    for r in rows:
+        pose = step_end_pose(r, pose, dt)
+    nxt[_POSE_STATE] = pose
+    # where a swept test of the next step would start (the row's d_HR, clipped at 0; no step is played from an
+    # unsafe state, so the clipping and a contact row's own moment do not matter)
+    nxt[L.S_D_SEP] = row[L.M_D]
     for r in rows:
         K.latch_seen(params, nxt, np.int64(r[L.M_SEEN]), float(r[L.M_T]))
