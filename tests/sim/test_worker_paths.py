@@ -22,8 +22,15 @@ def test_paths_are_the_simulated_poses(cell) -> None:
     assert paths.shape == (300, sim.actions_per_episode * sim.steps_per_action, L.N_POSE)
     blocked = 0
     for e in range(len(acts)):
-        rows = sim.run(acts[e]).rows[1:]  # (the first row is s0)
-        assert np.array_equal(paths[e, : len(rows)], rows[:, POSE]), e
+        trace = sim.run(acts[e])
+        rows = trace.rows[1:]  # (the first row is s0)
+        own = rows[:, L.M_SWEPT] == 0.0
+        assert np.array_equal(paths[e, : len(rows)][own], rows[own][:, POSE]), e
+        for i in np.flatnonzero(~own):  # a contact within a step: the pose of its moment, on the line between
+            before = paths[e, i - 1] if i > 0 else trace.rows[0][POSE]  # the step's two poses
+            s = (rows[i, L.M_TC] - (rows[i, L.M_T] - sim.dt)) / sim.dt
+            assert 0.0 < s <= 1.0
+            np.testing.assert_allclose(rows[i, POSE], before + s * (paths[e, i] - before), rtol=0.0, atol=1e-12)
         walked = np.hypot(*np.diff(paths[e, :, :2], axis=0).T)
         blocked += int(np.sum((acts[e].repeat(sim.steps_per_action)[1:] < 6) & (walked == 0.0)))
     assert blocked > 0  # some walks ran into a wall, the table or a fence and were stopped there

@@ -400,7 +400,7 @@ def sweep_step(P, prev, state, W, row):
         top += 2
     if found == 0:
         return False
-    _copy_contact(W.crow, row, found_t, float(found))
+    _copy_contact(W.crow, row, W.crow[M_TC], float(found))  # the moment of the pose it holds (a flag: an end's)
     if judged:
         return False
     row[M_UNSAFE] = 1.0
