@@ -83,7 +83,7 @@ def test_a_robot_at_rest_stays_at_rest(cell) -> None:
     bounds = Bounds(sim, horizon=n)
     rng = np.random.default_rng(3)
     rested = 0
-    for acts in rng.integers(0, 6, size=(150, n)):  # walking (with any posture), into the cell
+    for acts in rng.integers(0, 6, size=(400, n)):  # walking (with any posture), into the cell
         rows = sim.run(acts).rows
         t_stop = np.inf
         state = sim.reset()
