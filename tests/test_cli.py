@@ -360,3 +360,32 @@ def test_check_declared_capsules(capsys, baseline, tmp_path) -> None:
     assert code == 0, err
     assert re.search(r"^capsules\s+1 \(1 declared\)", out, re.M)
     assert re.search(r"forearm_link\s+on joint\s+\d+\s+radius 0\.080 m\s+length 0\.500 m", out)
+
+
+def test_a_proof_and_a_search_keep_the_rows_check_fails(capsys, tmp_path) -> None:
+    # door-locked with its front wall raised 0.35 m, the worker outside in front of it: check FAILs the slot under
+    # the wall (the whole body passes, ISO 13857), which the paper's worker cannot crawl through. verify proves the
+    # model safe and search finds nothing; both must say the static FAIL stands, and why they could not test it.
+    data = yaml.safe_load(resources.files("cellstress.cell").joinpath("builtin", "door-locked.yaml").read_text())
+    next(f for f in data["fences"] if f["points"] == [[-1.5, 3.2], [1.5, 3.2]])["bottom"] = 0.35
+    data["human"]["start"] = {"xy": [0.0, 3.8], "heading_deg": -90.0}
+    cell = tmp_path / "raised.yaml"
+    cell.write_text(yaml.safe_dump(data), encoding="utf-8")
+    code, out, _ = _run(["verify", str(cell), "--horizon", "1", "--phases", "cell", "--workers", "1",
+                         "--out", str(tmp_path / "v")], capsys)
+    assert code == 0 and "PROVED-SAFE" in out
+    line = next(ln for ln in out.splitlines() if ln.startswith("static "))
+    assert "check FAILs whole-body-opening" in line and "cannot crawl" in line and "this proof does not cover" in line
+    saved = json.loads((tmp_path / "v" / "verify.json").read_text())
+    assert [f["name"] for f in saved["static_failures"]] == ["whole-body-opening"]
+    assert "cannot crawl" in (tmp_path / "v" / "verify.html").read_text()
+    code, out, _ = _run(["search", str(cell), "--searcher", "random", "--budget", "2", "--no-report",
+                         "--out", str(tmp_path / "s")], capsys)
+    assert code == 0 and "no hazard found" in out
+    assert any(ln.startswith("static    check FAILs whole-body-opening") and "this search does not cover" in ln
+               for ln in out.splitlines())
+    # the baseline passes check: nothing to keep
+    code, out, _ = _run(["verify", "baseline", "--horizon", "1", "--phases", "cell", "--workers", "1",
+                         "--out", str(tmp_path / "b")], capsys)
+    assert code == 0 and "static " not in out
+    assert json.loads((tmp_path / "b" / "verify.json").read_text())["static_failures"] == []

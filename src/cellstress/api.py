@@ -17,6 +17,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from cellstress.analysis.check_rows import static_failures
 from cellstress.analysis.iso13855 import StaticCheck, check_cell
 from cellstress.cell import load
 from cellstress.cell.load import Cell
@@ -99,7 +100,9 @@ def verify(cell: CellLike, *, horizon: int | None = None, phases: str = "all", m
 
     ``.verdict`` is ``PROVED-SAFE``, ``UNSAFE`` or ``UNDECIDED`` (``time_limit`` [s] ran out; never a proof);
     ``.hazardous`` the exact number of hazardous sequences, per sub-tree in ``.subtrees``; ``.classes`` one witness
-    per hazard class. ``workers`` processes decide sub-trees in parallel; ``out``: a folder for verify.json and
+    per hazard class; ``.static_failures`` the rows ``check`` fails, which a proof of the simulated worker does not
+    clear (each says what that worker cannot do there, if anything). ``workers`` processes decide sub-trees in parallel; ``out``: a folder for verify.json and
     the witnesses' replayable result files. docs/verify.md says what a proof means."""
-    return verify_cell(Simulator(_cell(cell, criterion)), horizon=horizon, phases=phases, moments=moments,
-                       time_limit=time_limit, workers=workers, out=out, progress=progress)
+    sim = Simulator(_cell(cell, criterion))
+    return verify_cell(sim, horizon=horizon, phases=phases, moments=moments, time_limit=time_limit, workers=workers,
+                       out=out, progress=progress, static_failures=static_failures(check_cell(sim.cell)))

@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 
 from cellstress.analysis.espe_rules import BeamHeights, CurtainReachOver, ScannerMounting
+from cellstress.verifier.records import StaticFailure
 
 
 @dataclass(frozen=True)
@@ -24,6 +25,7 @@ class CheckRow:
     ok: bool
     value: str  # the measured quantity and its requirement, e.g. '0.412 m (needs 0.530 m)' ('' when none)
     detail: str  # the check's own line(s) of text
+    limit: str = ""  # what the simulated worker cannot do to take this way in ('' where it can, or the row passes)
 
 
 def _m(x: float) -> str:
@@ -39,18 +41,19 @@ def _access_rows(rule) -> list[CheckRow]:
     text = rule.line()
     if isinstance(rule, CurtainReachOver):
         return [CheckRow(_robot(f"{rule.device}-reach-over", rule.robot), "ISO 13855 reach over a curtain", rule.ok,
-                         f"{_m(rule.behind)} (needs {_m(rule.required)})", text)]
+                         f"{_m(rule.behind)} (needs {_m(rule.required)})", text, rule.model_limit)]
     if isinstance(rule, BeamHeights):
         return [CheckRow(f"{rule.device}-crawl-under", "ISO 13855 crawling under", rule.crawl_ok,
-                         f"lowest beam {rule.bottom:.3f} m", text),
+                         f"lowest beam {rule.bottom:.3f} m", text, "" if rule.crawl_ok else rule.model_limit),
                 CheckRow(f"{rule.device}-step-over", "ISO 13855 stepping over", rule.step_ok,
-                         f"highest beam {rule.top:.3f} m", text)]
+                         f"highest beam {rule.top:.3f} m", text, "" if rule.step_ok else rule.model_limit)]
     if isinstance(rule, ScannerMounting):
         return [CheckRow(f"{rule.device}-mounting", "ISO 13855 scanner mounting height", rule.resolution_ok,
                          f"scan plane {rule.height:.3f} m", text),
                 CheckRow(f"{rule.device}-crawl-under", "ISO 13855 crawling under", rule.crawl_ok,
-                         f"scan plane {rule.height:.3f} m", text)]
-    return [CheckRow(f"{rule.device}-depth", "ISO 13855 mat depth", rule.ok, f"depth {_m(rule.depth)}", text)]
+                         f"scan plane {rule.height:.3f} m", text, rule.model_limit)]
+    return [CheckRow(f"{rule.device}-depth", "ISO 13855 mat depth", rule.ok, f"depth {_m(rule.depth)}", text,
+                     rule.model_limit)]
 
 
 def check_rows(static, programs=()) -> tuple[CheckRow, ...]:
@@ -84,7 +87,8 @@ def check_rows(static, programs=()) -> tuple[CheckRow, ...]:
         bad = [o for o in static.openings if not o.ok]
         rows.append(CheckRow("whole-body-opening", "ISO 13857 whole-body openings", not bad,
                              f"{len(bad)} of {len(static.openings)} openings admit the body unseen",
-                             "\n".join(o.line() for o in static.openings)))
+                             "\n".join(o.line() for o in static.openings),
+                             "; ".join(dict.fromkeys(o.sim_note for o in bad if o.sim_note))))
     for rule in static.access:
         rows += _access_rows(rule)
     return _unique(rows)
@@ -95,5 +99,13 @@ def _unique(rows: list[CheckRow]) -> tuple[CheckRow, ...]:
     out = []
     for r in rows:
         n = seen[r.name] = seen.get(r.name, 0) + 1
-        out.append(r if n == 1 else CheckRow(f"{r.name}#{n}", r.kind, r.ok, r.value, r.detail))
+        out.append(r if n == 1 else CheckRow(f"{r.name}#{n}", r.kind, r.ok, r.value, r.detail, r.limit))
     return tuple(out)
+
+
+def static_failures(static, programs=()) -> tuple[StaticFailure, ...]:
+    """The failing rows of a ``StaticCheck`` (and ``ProgramCheck``s), as a verdict keeps them beside itself: a proof
+    or a search of the simulated worker does not clear a row the static check fails (``limit`` says why it may
+    not even try)."""
+    return tuple(StaticFailure(name=r.name[:200], value=r.value[:400], limit=r.limit[:400])
+                 for r in check_rows(static, programs) if not r.ok)

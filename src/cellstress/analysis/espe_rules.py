@@ -71,13 +71,18 @@ class CurtainReachOver:
     def ok(self) -> bool:
         return self.behind >= self.required - _TOL
 
+    @property
+    def model_limit(self) -> str:
+        """What the simulated worker cannot do to take this way in ('' where the row passes)."""
+        return "" if self.ok else CANNOT_REACH_OVER
+
     def line(self) -> str:
         lo, hi = self.band
         b = self.top * 1000.0
         if math.isinf(self.c_ro):
             return (f"{self.device}: reach over its top (ISO 13855 6.5, Table 1): upper edge b = {mm(b)} mm is below "
                     f"the table's first column ({mm(I.C_RO_B_MM[0])} mm): no distance is enough: FAIL; "
-                    + CANNOT_REACH_OVER)
+                    + self.model_limit)
         band = f"a {lo * 1000:.0f}..{hi * 1000:.0f} mm" if math.isfinite(hi) else f"a >= {lo * 1000:.0f} mm"
         text = (f"{self.device}: reach over its top (ISO 13855 6.5, Table 1): b = {mm(b)} mm, hazard at "
                 f"{self.hazard_height:.2f} m ({band}): C_RO = {mm(self.c_ro)} mm, S_RO = {mm(self.K)}*{self.T:.2f} + "
@@ -86,7 +91,7 @@ class CurtainReachOver:
                 f"{mm(self.required * 1000)}) = {mm(max(self.through, self.required) * 1000)} mm")
         if self.robot_part:
             text += f" ({self.robot_part} at t = {self.t:.2f} s)"
-        return text if self.ok else text + "; " + CANNOT_REACH_OVER
+        return text if self.ok else text + "; " + self.model_limit
 
 
 def _c_ro_bands(top: float) -> list[tuple[float, float, float]]:
@@ -150,12 +155,17 @@ class BeamHeights:
     def ok(self) -> bool:
         return self.crawl_ok and self.step_ok
 
+    @property
+    def model_limit(self) -> str:
+        """What the simulated worker cannot do to take this way in ('' where the row passes)."""
+        return "" if self.ok else CANNOT_CRAWL
+
     def line(self) -> str:
         lo, hi = self.bottom * 1000.0, self.top * 1000.0
         text = (f"{self.device}: lowest beam {mm(lo)} mm <= {mm(I.CRAWL_UNDER_MAX_MM)} mm (crawling under)? "
                 f"{'ok' if self.crawl_ok else 'FAIL'}; highest beam {mm(hi)} mm >= {mm(I.STEP_OVER_MIN_MM)} mm "
                 f"(stepping over)? {'ok' if self.step_ok else 'FAIL'} (ISO 13855 6.2, whole-body detection)")
-        return text if self.ok else text + "; " + CANNOT_CRAWL
+        return text if self.ok else text + "; " + self.model_limit
 
 
 @dataclass(frozen=True)
@@ -188,15 +198,18 @@ class ScannerMounting:
     def ok(self) -> bool:
         return self.resolution_ok and self.crawl_ok
 
+    @property
+    def model_limit(self) -> str:
+        """What the simulated worker cannot do to take this way in: crawl under the plane ('' where it need not)."""
+        return "" if self.crawl_ok else CANNOT_CRAWL
+
     def line(self) -> str:
         h, d = self.height * 1000.0, self.resolution
         text = (f"{self.device}: scan plane H = {mm(h)} mm, resolution d = {mm(d)} mm: H >= 15*({mm(d)} - 50) = "
                 f"{mm(self.min_height_mm)} mm? {'ok' if self.resolution_ok else 'FAIL'}; H <= "
                 f"{mm(I.CRAWL_UNDER_MAX_MM)} mm (crawling under)? {'ok' if self.crawl_ok else 'FAIL'} (ISO 13855 "
                 f"6.3; its C = {mm(self.c_mm)} mm is in S)")
-        if not self.crawl_ok:
-            text += "; " + CANNOT_CRAWL
-        return text
+        return text + "; " + self.model_limit if self.model_limit else text
 
 
 # ---- the depth of a safety mat (ISO 13855:2010, pressure-sensitive mats) -----------------------------------
@@ -213,6 +226,11 @@ class MatDepth:
     def ok(self) -> bool:
         return self.depth * 1000.0 >= I.MAT_MIN_DEPTH_MM - 1e-6
 
+    @property
+    def model_limit(self) -> str:
+        """What the simulated worker cannot do to take this way in ('' where the row passes)."""
+        return "" if self.ok else CANNOT_CRAWL
+
     def line(self) -> str:
         need = f"{mm(I.MAT_MIN_DEPTH_MM)} mm (stepping across it unseen; ISO 13855, pressure-sensitive mats)"
         if self.where is None:
@@ -221,7 +239,7 @@ class MatDepth:
         (x0, y0), (x1, y1) = self.where
         text = (f"{self.device}: depth {mm(self.depth * 1000)} mm from ({x0:.2f}, {y0:.2f}) to ({x1:.2f}, {y1:.2f}) "
                 f">= {need}? {'ok' if self.ok else 'FAIL'}")
-        return text if self.ok else text + "; " + CANNOT_CRAWL
+        return text if self.ok else text + "; " + self.model_limit
 
 
 def _ray_exit(p, n, poly, skip: int) -> tuple[float, int]:

@@ -76,13 +76,14 @@ def search(
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
+    from cellstress.analysis.check_rows import static_failures
     from cellstress.analysis.iso13855 import check_cell
     from cellstress.analysis.shortfall import shortfall
     from cellstress.cell.load import load_cell, with_criterion
     from cellstress.cli.report import after_search
     from cellstress.criteria.iso15066 import CREEP_SPEED
     from cellstress.report.junit import search_suite
-    from cellstress.report.scope import NOT_A_PROOF, judged_by, search_scope, strongest_contact
+    from cellstress.report.scope import NOT_A_PROOF, judged_by, search_scope, static_lines, strongest_contact
     from cellstress.searchers import make_searcher, parse_options
     from cellstress.searchers import search as run
     from cellstress.searchers.common import check_common
@@ -161,7 +162,7 @@ def search(
     echo(f"criterion {judged_by(sim.criterion)}")
     best = max(result.risk_per_episode, default=0.0)
     h = result.hazard
-    static = None if h is None else check_cell(sim.cell)  # the distances a failed safeguard fell short by
+    static = check_cell(sim.cell)  # the distances a failed safeguard fell short by; the rows a search did not clear
     if h is None:
         echo(f"no hazard found in {result.episodes} episodes (best risk {best:.3f}; {elapsed:.2f} s, "
              f"{rate:.0f} episodes/s)")
@@ -169,6 +170,8 @@ def search(
         strongest = strongest_contact(sim, result.top[0].actions) if result.top else None
         if strongest is not None:
             echo(f"strongest contact of the riskiest episode ({result.top[0].episode}): {strongest}")
+        for line in static_lines(static_failures(static), "this search"):
+            echo(line)
         echo(f"note      {NOT_A_PROOF}")
     else:
         extra_text = f", {len(result.hazards)} hazardous episodes in all" if until == "budget" else ""

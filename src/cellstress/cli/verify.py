@@ -50,6 +50,8 @@ def verify(
     from rich.console import Console
     from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
+    from cellstress.analysis.check_rows import static_failures
+    from cellstress.analysis.iso13855 import check_cell
     from cellstress.cell.load import load_cell, with_criterion
     from cellstress.core.cpus import check_workers, usable_cpus
     from cellstress.report.junit import verify_suite
@@ -78,7 +80,7 @@ def verify(
             sim = Simulator(with_criterion(load_cell(cell), criterion))
             res = verify_cell(sim, horizon=horizon, phases=phases, moments=moments, time_limit=time_limit,
                               workers=usable_cpus() if workers is None else workers, out=out_dir,
-                              progress=tick)
+                              progress=tick, static_failures=static_failures(check_cell(sim.cell)))
     except KeyboardInterrupt:
         say("interrupted: nothing was decided (run the same command again)", err=True)
         raise typer.Exit(INTERRUPTED) from None

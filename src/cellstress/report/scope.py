@@ -77,3 +77,17 @@ def strongest_contact(sim, actions) -> str | None:
         return None
     worst = max(verdicts, key=lambda v: getattr(v, "ratio", 0.0))
     return worst.summary()
+
+
+def static_lines(failures, verdict: str) -> list[str]:
+    """One ``static`` line per row ``cellstress check`` fails (``StaticFailure``s) beside a ``verdict`` ("this
+    proof", "this search") that found no contact: the static verdict stands, and where the simulated worker cannot
+    take that way in at all, the line says what it cannot do."""
+    out = []
+    for f in failures:
+        head = f"static    check FAILs {f.name} ({f.value}): "
+        if f.limit:
+            out.append(head + f"{f.limit}; {verdict} does not cover that way in: the static verdict stands")
+        else:
+            out.append(head + f"{verdict} turned it into no contact within its scope; the static verdict stands")
+    return out

@@ -16,6 +16,7 @@ from cellstress.report.episode import replay
 from cellstress.report.scene3d import view_of_episodes
 from cellstress.report.view3d import STYLE as VIEW3D_STYLE
 from cellstress.report.view3d import view_fragment
+from cellstress.report.scope import static_lines
 from cellstress.searchers.severity import words as severity_words
 from cellstress.verifier.records import PROVED_SAFE, UNDECIDED, UNSAFE, VerifyResult
 
@@ -101,6 +102,8 @@ def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None
         confirmed = sum(s.confirmed for s in res.subtrees)
         lines.append(f"UNSAFE: none hazardous at the grid moments, but {confirmed:,} sequences are at arrival "
                      "moments between them (replayed; their witnesses below)")
+    if res.verdict != UNSAFE:
+        lines += static_lines(res.static_failures, "this proof")
     if sc.horizon < sc.cell_horizon:
         lines.append(f"note      {sc.horizon} actions per episode, fewer than the cell's own {sc.cell_horizon}: "
                      "contacts after them are not decided")
@@ -163,6 +166,9 @@ def verify_page(res: VerifyResult, png: str | Path, path: str | Path, criterion_
             f'<div class="verdict {"safe" if res.verdict == PROVED_SAFE else "hazard"}">{escape(verdict)}</div>',
             H.table(None, [[ln.split(" ", 1)[0], ln.split(" ", 1)[1].strip()] for ln in lines[:3 + len(res.pruned)]]),
             f"<p>{escape(res.scope.statement)}</p>",
+            *([H.table(["check row that fails", "value", "what the simulated worker cannot do"],
+                       [[f.name, f.value, f.limit or "(it can; no sequence of this scope did)"]
+                        for f in res.static_failures])] if res.static_failures else []),
             H.table(["approximation", "size", "what"],
                     [[a.name, f"{a.size:.3g} {a.unit}" if a.size else "", a.what]
                      for a in res.scope.approximations]),

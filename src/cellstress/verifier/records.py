@@ -116,6 +116,16 @@ class Witness(Record):
     severity: Severity | None = None  # its contact's (searchers.severity): the classes are listed worst first
 
 
+class StaticFailure(Record):
+    """A row ``cellstress check`` fails, kept beside a verdict that did not turn it into a contact (a proof is about
+    the simulated worker; the static check is about any person): ``limit`` names what the simulated worker cannot
+    do there, '' where it could but no sequence of the verdict's scope did."""
+
+    name: Name
+    value: Annotated[str, Field(max_length=400)]
+    limit: Annotated[str, Field(max_length=400)] = ""
+
+
 class VerifyResult(Record):
     """What ``cellstress.verify`` returns and ``verify.json`` holds."""
 
@@ -134,6 +144,7 @@ class VerifyResult(Record):
     subtrees: tuple[Subtree, ...]
     classes: tuple[Witness, ...]
     version: Name
+    static_failures: tuple[StaticFailure, ...] = ()  # the cell's failing check rows (cellstress.analysis.check_rows)
     format: Literal[2] = FORMAT
 
     @property

@@ -35,6 +35,7 @@ from cellstress.verifier.records import (
     UNSAFE,
     ClassCount,
     Pruned,
+    StaticFailure,
     Subtree,
     VerifyOptions,
     VerifyResult,
@@ -197,7 +198,8 @@ def tasks_of(sim: Simulator, options: VerifyOptions, deadline: float | None, cov
 
 
 def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out: str | Path | None = None,
-               progress: Callable[[int, int], None] | None = None) -> VerifyResult:
+               progress: Callable[[int, int], None] | None = None,
+               static_failures: tuple[StaticFailure, ...] = ()) -> VerifyResult:
     """Decide ``sim``'s cell (see ``cellstress.api.verify``). ``progress(sequences decided, of)``; ``out``: a folder
     for ``verify.json`` and one witness per hazard class (``witness-NN/result.json``)."""
     cell = sim.cell
@@ -224,11 +226,11 @@ def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out:
             for f in futures:
                 f.add_done_callback(lambda f: tick(f.result().subtree.sequences) if not f.exception() else None)
             decided = [f.result() for f in futures]
-    return assemble(sim, options, tasks, decided, out)
+    return assemble(sim, options, tasks, decided, out, static_failures)
 
 
 def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided: list[Decided],
-             out: str | Path | None) -> VerifyResult:
+             out: str | Path | None, static_failures: tuple[StaticFailure, ...] = ()) -> VerifyResult:
     """The result of the decided sub-trees: hazard classes numbered worst first (``searchers.severity``; ties in
     the order first found), their witnesses written (if ``out``)."""
     cell = sim.cell
@@ -279,7 +281,8 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
         sequences=sum(s.sequences for s in subtrees), hazardous=hazardous, undecided=undecided, alarms=alarms,
         states=sum(sum(s.states) for s in subtrees),
         pruned=tuple(Pruned(bound=b, states=v[0], sequences=v[1]) for b, v in pruned.items()),
-        subtrees=tuple(subtrees), classes=tuple(witnesses), version=__version__)
+        subtrees=tuple(subtrees), classes=tuple(witnesses), version=__version__,
+        static_failures=tuple(static_failures))
     if out is not None:
         result.write(out)
     return result
@@ -300,8 +303,10 @@ def check_witness_folders(out: Path) -> None:
 
 def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "all", moments: str = "all",
                 time_limit: float | None = None, bounds: tuple[str, ...] | None = None, workers: int = 1,
-                out: str | Path | None = None, progress: Callable[[int, int], None] | None = None) -> VerifyResult:
-    """``run_verify`` with its options checked: VerifyError (a user error) for a bad one."""
+                out: str | Path | None = None, progress: Callable[[int, int], None] | None = None,
+                static_failures: tuple[StaticFailure, ...] = ()) -> VerifyResult:
+    """``run_verify`` with its options checked: VerifyError (a user error) for a bad one. ``static_failures``: the
+    cell's failing ``check`` rows (``cellstress.analysis.check_rows.static_failures``), kept in the result."""
     fields: dict[str, Any] = {"horizon": sim.actions_per_episode if horizon is None else horizon, "phases": phases,
                               "moments": moments}
     if time_limit is not None:
@@ -323,4 +328,4 @@ def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "al
         # its bounds are the paper worker's (30 actions, reach volumes on rigid shoulders: docs/verify.md)
         raise VerifyError(f"verify proves cells with the paper's worker only; this cell's is "
                           f"{sim.cell.spec.human.model!r} (human.model)")
-    return run_verify(sim, options, workers=workers, out=out, progress=progress)
+    return run_verify(sim, options, workers=workers, out=out, progress=progress, static_failures=static_failures)
