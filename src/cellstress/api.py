@@ -101,8 +101,9 @@ def verify(cell: CellLike, *, horizon: int | None = None, phases: str = "all", m
     ``.verdict`` is ``PROVED-SAFE``, ``UNSAFE`` or ``UNDECIDED`` (``time_limit`` [s] ran out; never a proof);
     ``.hazardous`` the exact number of hazardous sequences, per sub-tree in ``.subtrees``; ``.classes`` one witness
     per hazard class; ``.static_failures`` the rows ``check`` fails, which a proof of the simulated worker does not
-    clear (each says what that worker cannot do there, if anything). ``workers`` processes decide sub-trees in parallel; ``out``: a folder for verify.json and
-    the witnesses' replayable result files. docs/verify.md says what a proof means."""
+    clear (each says what that worker cannot do there, if anything). ``workers`` processes decide sub-trees in
+    parallel; ``out``: a folder for verify.json and the witnesses' replayable result files. docs/verify.md says
+    what a proof means."""
     sim = Simulator(_cell(cell, criterion))
     return verify_cell(sim, horizon=horizon, phases=phases, moments=moments, time_limit=time_limit, workers=workers,
                        out=out, progress=progress, static_failures=static_failures(check_cell(sim.cell)))

@@ -14,9 +14,9 @@ from cellstress.report import draw as D
 from cellstress.report import html as H
 from cellstress.report.episode import replay
 from cellstress.report.scene3d import view_of_episodes
+from cellstress.report.scope import static_lines
 from cellstress.report.view3d import STYLE as VIEW3D_STYLE
 from cellstress.report.view3d import view_fragment
-from cellstress.report.scope import static_lines
 from cellstress.searchers.severity import words as severity_words
 from cellstress.verifier.records import PROVED_SAFE, UNDECIDED, UNSAFE, VerifyResult
 
