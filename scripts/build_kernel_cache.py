@@ -67,6 +67,8 @@ COMMANDS = [
     ["search", "s2-elbow-intrusion", "--searcher", "evolve", "--budget", "30", "--seed", "0", "--set", "score=all",
      "--out", "{out}/la"],
     ["@scripts/curtain_probe.py", "s2-elbow-intrusion", "--step", "0.25"],  # analysis.probe
+    # the 5 ms cross-check of the swept test (kernels.dense), which tests/sim/test_sweep.py runs on every CI
+    ["@benchmarks/sweep_check.py", "--cells", "s3-fence-gap", "--episodes", "20"],
 ]
 
 
