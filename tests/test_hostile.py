@@ -1,10 +1,10 @@
 """Hostile inputs: cell files, result files, options and names that other people might send.
 
-Each case runs the command line in a process of its own, under a time limit and an address-space limit, in a
-working folder of its own. Each asserts the exit code (2 for a bad input, with exactly one line on stderr
-that starts with ``error:``; 1 for a result file whose claims do not hold; 0 for a strange but valid input),
-no traceback, nothing created or changed outside the output folder, and text escaped for where it lands
-(terminal, HTML, CSV, Markdown).
+Each case runs the command line in a process of its own (forked from one that has imported cellstress), under a
+time limit and an address-space limit, in a working folder of its own. Each asserts the exit code (2 for a bad
+input, with exactly one line on stderr that starts with ``error:``; 1 for a result file whose claims do not hold;
+0 for a strange but valid input), no traceback, nothing created or changed outside the output folder, and text
+escaped for where it lands (terminal, HTML, CSV, Markdown).
 
 The cases are samples of kinds (files that are not files, bombs, deep nesting, numbers out of range, lax
 types, forged results, names that try to become paths or markup); the code under test handles the kind, not
@@ -24,6 +24,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
+from queue import Queue
 
 import pytest
 import yaml
@@ -61,6 +62,48 @@ for argv in json.load(open(sys.argv[1])):
     raw = fd2.read().decode("utf-8", "replace")
     done.append({{"code": code, "out": out.getvalue(), "err": raw + err.getvalue()}})
 json.dump(done, open(sys.argv[2], "w"))
+"""
+# Each group's process is forked from one that has already imported cellstress and what its commands import (a
+# fresh interpreter spends seconds on those imports; 190 groups did): it is still a process of its own, in its own
+# folder, under the same limits; it runs CHILD. Nothing runs a kernel before the fork (numba's thread pools are not
+# fork-safe); each child loads its kernels as a fresh process does.
+FORKS = f"""
+import importlib, json, os, pkgutil, signal, sys, time
+import cellstress
+for m in pkgutil.walk_packages(cellstress.__path__, "cellstress."):
+    if not m.name.endswith("__main__"):
+        try:
+            importlib.import_module(m.name)
+        except Exception:
+            pass
+child = compile({CHILD!r}, "<child>", "exec")
+for line in sys.stdin:
+    req = json.loads(line)
+    pid = os.fork()
+    if pid == 0:
+        status = 1
+        try:
+            os.chdir(req["cwd"])
+            null = os.open(os.devnull, os.O_RDWR)
+            os.dup2(null, 0)
+            os.dup2(null, 1)  # (fd 1 is the answer pipe)
+            sys.argv = ["-c", req["commands"], req["report"]]
+            exec(child, {{"__name__": "__main__"}})
+            status = 0
+        finally:
+            os._exit(status)
+    deadline, status = time.monotonic() + {TIME_LIMIT}, None
+    while True:
+        done, raw = os.waitpid(pid, os.WNOHANG)
+        if done:
+            status = os.waitstatus_to_exitcode(raw)
+            break
+        if time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            break
+        time.sleep(0.02)
+    print(json.dumps(status), flush=True)
 """
 CELL, RESULT = "in/cell.yaml", "out/result.json"
 SEARCH = ("search", CELL, "--budget", "2", "--searcher", "random", "--out", "out", "--no-report")
@@ -776,20 +819,41 @@ def _group(case: Case) -> str:
     return "options" if case in OPTIONS else case.id
 
 
-def _run_group(cases: list[Case], folder: Path, commands: Path, env: dict[str, str]) -> list[Ran]:
+class _Forks:
+    """A process that has imported cellstress and forks a child per group (``FORKS``), one group at a time."""
+
+    def __init__(self, env: dict[str, str], log: Path) -> None:
+        self.log = log
+        with log.open("wb") as err:
+            self.p = subprocess.Popen([sys.executable, "-c", FORKS], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                      stderr=err, env=env, text=True)
+
+    def run(self, folder: Path, commands: Path, report: Path) -> int | None:
+        """The child's exit status; None when it ran out of time (and was killed)."""
+        self.p.stdin.write(json.dumps({"cwd": str(folder), "commands": str(commands), "report": str(report)}) + "\n")
+        self.p.stdin.flush()
+        answer = self.p.stdout.readline()
+        if not answer:
+            raise RuntimeError(f"the fork server died: {self.log.read_text(errors='replace')[-1500:]}")
+        return json.loads(answer)
+
+    def close(self) -> None:
+        self.p.stdin.close()
+        self.p.wait(timeout=60)
+
+
+def _run_group(cases: list[Case], folder: Path, commands: Path, forks: _Forks) -> list[Ran]:
     before = _snapshot(folder)
     commands.write_text(json.dumps([list(c.argv) for c in cases]))
     report = commands.with_suffix(".out.json")
-    try:
-        p = subprocess.run([sys.executable, "-c", CHILD, str(commands), str(report)], cwd=folder, env=env,
-                           capture_output=True, timeout=TIME_LIMIT, stdin=subprocess.DEVNULL)
-        done = json.loads(report.read_text()) if p.returncode == 0 else []
+    status = forks.run(folder, commands, report)
+    if status is None:
+        ran = [Ran(None, "", f"timed out after {TIME_LIMIT} s") for _ in cases]
+    else:
+        done = json.loads(report.read_text()) if status == 0 and report.exists() else []
         ran = [Ran(d["code"], d["out"], d["err"]) for d in done]
         if len(ran) != len(cases):
-            problem = f"the process ended with {p.returncode}: {p.stderr.decode('utf-8', 'replace')[-1500:]}"
-            ran = [Ran(-1, "", problem) for _ in cases]
-    except subprocess.TimeoutExpired:
-        ran = [Ran(None, "", f"timed out after {TIME_LIMIT} s") for _ in cases]
+            ran = [Ran(-1, "", f"the process ended with {status} (its stderr: {forks.log})") for _ in cases]
     after = _snapshot(folder)
     for r in ran:
         r.before, r.after = before, after
@@ -816,14 +880,28 @@ def ran(tmp_path_factory) -> dict[str, tuple[Path, Ran]]:
     for name, cases in groups.items():
         folders[name] = root / "cases" / name
         _prepare(cases[0], folders[name], baseline, result)
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        futures = {name: pool.submit(_run_group, cases, folders[name], root / "commands" / f"{name}.json", env)
-                   for name, cases in groups.items()}
-        out = {}
-        for name, cases in groups.items():
-            for case, r in zip(cases, futures[name].result(), strict=True):
-                out[case.id] = (folders[name], r)
-        return out
+    servers: Queue[_Forks] = Queue()
+    for i in range(2):
+        servers.put(_Forks(env, root / f"forks-{i}.log"))
+
+    def run(name: str) -> list[Ran]:
+        forks = servers.get()
+        try:
+            return _run_group(groups[name], folders[name], root / "commands" / f"{name}.json", forks)
+        finally:
+            servers.put(forks)
+
+    try:
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            futures = {name: pool.submit(run, name) for name in groups}
+            out = {}
+            for name, cases in groups.items():
+                for case, r in zip(cases, futures[name].result(), strict=True):
+                    out[case.id] = (folders[name], r)
+            return out
+    finally:
+        while not servers.empty():
+            servers.get().close()
 
 
 def test_the_corpus_is_large_and_varied() -> None:
