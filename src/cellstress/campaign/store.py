@@ -1,10 +1,9 @@
 """``DIR/runs.jsonl``: one line per finished run, appended, flushed and fsynced when the run ends.
 
-Only the main process writes, one whole line per ``os.write`` on an ``O_APPEND`` descriptor, so a crash can
-leave at most a truncated last line. Reading tolerates exactly that: the partial line is dropped (the file is
-rewritten without it, atomically) and its run is done again. Lines are JSON with sorted keys and no
-wall-clock field, so sorting the lines of two campaigns' files gives byte-identical text whatever the order
-in which runs finished.
+Only the main process writes, one whole line at a time (``core.journal``), so a crash can leave at most a
+truncated last line; reading drops it (the file is rewritten without it) and its run is done again. Lines are
+JSON with sorted keys and no wall-clock field, so sorting the lines of two campaigns' files gives byte-identical
+text whatever the order in which runs finished.
 """
 
 from __future__ import annotations
@@ -21,7 +20,6 @@ from cellstress.campaign.plan import MANIFEST, CampaignError, CampaignPlan, Mani
 from cellstress.core.fields import Name, Record
 from cellstress.core.io import (
     InputFileError,
-    atomic_write,
     atomic_write_text,
     canonical_json,
     duplicate_json_key,
@@ -29,6 +27,7 @@ from cellstress.core.io import (
     json_ready,
     read_input_bytes,
 )
+from cellstress.core.journal import JournalWriter, read_journal
 from cellstress.searchers.common import MAX_BUDGET
 from cellstress.searchers.result import MAX_ACTIONS, Option, validation_problem
 
@@ -89,22 +88,13 @@ class Loaded:
 
 def read_runs(path: Path, plan: CampaignPlan) -> Loaded:
     """Read ``runs.jsonl``; repair a truncated last line; check every line belongs to ``plan``."""
-    if not os.path.lexists(path):
-        return Loaded({}, False)
     try:
-        raw = read_input_bytes(path, MAX_RUNS_BYTES, follow=False)
+        lines, dropped = read_journal(path, MAX_RUNS_BYTES)
     except InputFileError as exc:
         raise CampaignError(f"{path}: {exc.problem}") from None
-    lines = raw.split(b"\n")
-    tail = lines.pop()  # b"" when the file ends with a newline, else a line cut short by a crash
-    dropped = bool(tail)
-    if dropped:
-        atomic_write(path, raw[: len(raw) - len(tail)])
     expected = {s.key: s for s in plan.runs()}
     records: dict[RunKey, dict[str, Any]] = {}
     for n, line in enumerate(lines, start=1):
-        if not line.strip():
-            continue
         try:
             RunRecord.model_validate_json(line, strict=True)
         except ValidationError as exc:
@@ -129,32 +119,7 @@ def read_runs(path: Path, plan: CampaignPlan) -> Loaded:
     return Loaded(records, dropped)
 
 
-class RunWriter:
-    """Appends records to ``runs.jsonl``: one ``os.write`` of a whole line, then fsync."""
-
-    def __init__(self, path: Path):
-        self.path = path
-        # O_NOFOLLOW: a symbolic link planted at runs.jsonl must not redirect the appends to its target
-        self._fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o666)
-
-    def append(self, record: dict[str, Any]) -> None:
-        data = (json_line(record) + "\n").encode("utf-8")
-        view = memoryview(data)
-        while view:  # a regular file takes the whole line at once; loop only for safety
-            n = os.write(self._fd, view)
-            view = view[n:]
-        os.fsync(self._fd)
-
-    def close(self) -> None:
-        if self._fd >= 0:
-            os.close(self._fd)
-            self._fd = -1
-
-    def __enter__(self) -> RunWriter:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+RunWriter = JournalWriter  # appends the records to runs.jsonl (core.journal)
 
 
 class FolderLock:

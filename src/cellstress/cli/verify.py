@@ -28,7 +28,11 @@ def verify(
                                                 "simulation.actions_per_episode; at most 12).")] = None,
     phases: Annotated[str, typer.Option("--phases", help="all: every arrival phase of the robot's cycle on the "
                                         "time-step grid; cell: only the phases the cell's "
-                                        "human.arrival allows.")] = "all",
+                                        "human.arrival allows; A:B: the grid phases from A to B seconds of the "
+                                        "cycle (e.g. 1.0:2.5).")] = "all",
+    starts: Annotated[str | None, typer.Option("--starts", help="Start points to decide, by name, comma-separated "
+                                               "(default: every one; the single human.start is named 'start')."
+                                               )] = None,
     moments: Annotated[str, typer.Option("--moments", help="all: each grid phase also stands for every arrival "
                                          "moment within half a time step of it, where the cell allows the argument "
                                          "(docs/verify.md); grid: the grid moments alone (faster).")] = "all",
@@ -48,7 +52,7 @@ def verify(
     import time
 
     from rich.console import Console
-    from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+    from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
     from cellstress.analysis.check_rows import static_failures
     from cellstress.analysis.iso13855 import check_cell
@@ -58,6 +62,7 @@ def verify(
     from cellstress.report.scope import judged_by
     from cellstress.report.verify import HTML_NAME, PNG_NAME, hazard_map, summary_lines, verify_page, witness_view
     from cellstress.sim.simulator import Simulator
+    from cellstress.verifier.checkpoint import CHECKPOINT
     from cellstress.verifier.run import verify_cell
 
     with user_errors():
@@ -68,21 +73,28 @@ def verify(
     console = Console(stderr=True)
     bar = Progress(SpinnerColumn(), TextColumn("[bold]deciding"), BarColumn(),
                    TextColumn("{task.percentage:>5.1f} % of {task.fields[of]} sequences"), TimeElapsedColumn(),
+                   TextColumn("left"), TimeRemainingColumn(),
                    console=console, transient=True, disable=not console.is_terminal)
     task = bar.add_task("verify", total=1, of="?")
 
     def tick(done: int, total: int) -> None:
         bar.update(task, completed=done, total=total, of=f"{total:.3g}")
 
+    def resumed(n: int, of: int) -> None:
+        say(f"resumed   {n} of {of} sub-trees decided before, from {out_dir / CHECKPOINT}", err=True)
+
     t0 = time.perf_counter()
     try:
         with bar, user_errors():
             sim = Simulator(with_criterion(load_cell(cell), criterion))
             res = verify_cell(sim, horizon=horizon, phases=phases, moments=moments, time_limit=time_limit,
+                              starts=None if starts is None else tuple(n.strip() for n in starts.split(",")),
                               workers=usable_cpus() if workers is None else workers, out=out_dir,
-                              progress=tick, static_failures=static_failures(check_cell(sim.cell)))
+                              progress=tick, static_failures=static_failures(check_cell(sim.cell)),
+                              resumed=resumed)
     except KeyboardInterrupt:
-        say("interrupted: nothing was decided (run the same command again)", err=True)
+        say(f"interrupted: the sub-trees decided so far are kept in {out_dir / CHECKPOINT}; run the same command "
+            "again to go on from there", err=True)
         raise typer.Exit(INTERRUPTED) from None
     elapsed = time.perf_counter() - t0
     write_junit_file(junit_path, [verify_suite(res)])

@@ -143,5 +143,5 @@ def verify_suite(res) -> Suite:
         cases.append(Case(class_name(w.klass), "verify.witness", FAILED,
                           f"{w.sequences:,} sequences: {class_words(w.klass)}",
                           f"first at {w.start}, phase {w.phase:g} s: {', '.join(w.actions)}; witness {w.file}"))
-    return Suite(f"cellstress verify {res.cell.name} (horizon {res.options.horizon}, phases {res.options.phases})",
+    return Suite(f"cellstress verify {res.cell.name} (horizon {res.options.horizon}, phases {res.options.phases_text})",
                  tuple(cases))

@@ -3,6 +3,7 @@ summary ``cellstress verify`` prints."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from html import escape
 from pathlib import Path
 
@@ -67,6 +68,41 @@ def hazard_map(res: VerifyResult, path: str | Path, size: D.FigureSize = MAP_SIZ
     return D.save_png(fig, path)
 
 
+@dataclass(frozen=True)
+class Run:
+    """Sub-trees of one start point at consecutive arrival phases (in the verification's order) that share a
+    condition: how many, and the sum of what ``count`` counts in them."""
+
+    start: str
+    first: float
+    last: float
+    subtrees: int
+    count: int
+    window: float
+    margin: float
+
+    def where(self) -> str:
+        if self.subtrees == 1:
+            return f"{self.start} at phase {self.first:g} s"
+        return f"{self.start} at phases {self.first:g}..{self.last:g} s ({self.subtrees} sub-trees)"
+
+
+def runs(subtrees, count) -> list[Run]:
+    """The ranges of consecutive sub-trees with ``count(sub-tree)`` > 0, per start point."""
+    out: list[Run] = []
+    prev_in = False
+    for s in subtrees:
+        n = count(s)
+        if n and prev_in and out[-1].start == s.start:
+            r = out[-1]
+            out[-1] = Run(r.start, r.first, s.phase, r.subtrees + 1, r.count + n, max(r.window, s.window),
+                          max(r.margin, s.margin))
+        elif n:
+            out.append(Run(s.start, s.phase, s.phase, 1, n, s.window, s.margin))
+        prev_in = bool(n)
+    return out
+
+
 def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None) -> list[str]:
     """What ``cellstress verify`` prints: the scope, the proof's size, what each bound cut, the verdict, the
     hazardous sub-trees and each hazard class with its witness."""
@@ -74,7 +110,7 @@ def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None
     n_starts = len({s.start for s in res.subtrees})
     n_phases = len({s.phase for s in res.subtrees})
     lines = [
-        f"cell      {res.cell.name}  horizon {o.horizon} actions  phases {o.phases} ({len(res.subtrees)} "
+        f"cell      {res.cell.name}  horizon {o.horizon} actions  phases {o.phases_text} ({len(res.subtrees)} "
         f"sub-tree{'s' if len(res.subtrees) != 1 else ''}: {n_starts} start point{'s' if n_starts != 1 else ''}, "
         f"{n_phases} arrival phase{'s' if n_phases != 1 else ''})",
         f"criterion {criterion_text}",
@@ -122,15 +158,17 @@ def summary_lines(res: VerifyResult, criterion_text: str, out: str | None = None
     for s in between[:MAX_LISTED]:
         lines.append(f"  {s.start} within {s.window:g} s of phase {s.phase:g} s: {s.confirmed:,} sequences hazardous "
                      "at an arrival moment between grid points (replayed)")
-    undecided = [s for s in res.subtrees if s.undecided]
-    for s in undecided[:MAX_LISTED]:
-        lines.append(f"  undecided: {s.start} at phase {s.phase:g} s ({s.undecided:,} sequences)")
-    alarmed = [s for s in res.subtrees if s.alarms]
-    for s in alarmed[:MAX_LISTED]:
-        lines.append(f"  alarm: {s.start} within {s.window:g} s of phase {s.phase:g} s: {s.alarms:,} sequences touch "
-                     f"the robot grown by up to {s.margin * 1000:.0f} mm, none hazardous when replayed")
-    if len(undecided) + len(alarmed) > 2 * MAX_LISTED:
-        lines.append("  ... more in verify.json")
+    undecided = runs(res.subtrees, lambda s: s.undecided)
+    for r in undecided[:MAX_LISTED]:
+        lines.append(f"  undecided: {r.where()}: {r.count:,} sequences")
+    alarmed = runs(res.subtrees, lambda s: s.alarms)
+    for r in alarmed[:MAX_LISTED]:
+        lines.append(f"  alarm: {r.where()}, each within {r.window:g} s: {r.count:,} sequences touch the robot grown "
+                     f"by up to {r.margin * 1000:.0f} mm, none hazardous when replayed")
+    if len(undecided) > MAX_LISTED or len(alarmed) > MAX_LISTED:
+        more_u, more_a = max(len(undecided) - MAX_LISTED, 0), max(len(alarmed) - MAX_LISTED, 0)
+        lines.append(f"  ... {more_u} more undecided and {more_a} more alarmed ranges: every sub-tree is in "
+                     "verify.json")
     for i, w in enumerate(res.classes, start=1):
         k = w.klass
         failed = "no device saw the worker" if k.device == "none" else f"{k.device} stopped the robot too late"

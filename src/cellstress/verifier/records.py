@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from cellstress.core.fields import Record
 from cellstress.core.io import canonical_json, json_ready, write_in_folder
@@ -25,15 +25,32 @@ Count = Annotated[int, Field(ge=0)]
 
 class VerifyOptions(Record):
     """What to decide: episodes of ``horizon`` actions, at the arrival phases ``phases`` selects
-    (``verifier.phases``), with the pruning ``bounds`` named; ``time_limit`` [s] (None: none). ``moments``:
-    ``all``, each grid phase stands for every arrival moment within half a time step of it where the cell
-    allows the argument (``verifier.arrival``); ``grid``, the grid moments alone."""
+    (``verifier.phases``: ``all``, ``cell``, or ``window``, the grid phases within ``window`` [s]), from the start
+    points named in ``starts`` (none named: every one), with the pruning ``bounds`` named; ``time_limit`` [s]
+    (None: none). ``moments``: ``all``, each grid phase stands for every arrival moment within half a time step of
+    it where the cell allows the argument (``verifier.arrival``); ``grid``, the grid moments alone."""
 
     horizon: Annotated[int, Field(ge=1, le=12)] = 8
-    phases: Literal["all", "cell"] = "all"
+    phases: Literal["all", "cell", "window"] = "all"
     moments: Literal["all", "grid"] = "all"
     bounds: tuple[Literal["at-rest", "distance"], ...] = ("at-rest", "distance")
     time_limit: Annotated[float, Field(gt=0.0)] | None = None
+    window: tuple[Annotated[float, Field(ge=0.0, allow_inf_nan=False)],
+                  Annotated[float, Field(ge=0.0, allow_inf_nan=False)]] | None = None
+    starts: Annotated[tuple[Name, ...], Field(max_length=1000)] = ()
+
+    @model_validator(mode="after")
+    def _window_with_its_mode(self) -> VerifyOptions:
+        if (self.phases == "window") != (self.window is not None):
+            raise ValueError("phases: a window of phases (A:B) and only it gives the window's ends")
+        if self.window is not None and self.window[0] > self.window[1]:
+            raise ValueError(f"phases: the window {self.window[0]:g}:{self.window[1]:g} ends before it begins")
+        return self
+
+    @property
+    def phases_text(self) -> str:
+        """``all``, ``cell`` or the window ``A:B``, as the command line takes it."""
+        return self.phases if self.window is None else f"{self.window[0]:g}:{self.window[1]:g}"
 
 
 class Pruned(Record):

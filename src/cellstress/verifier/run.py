@@ -8,7 +8,7 @@ import multiprocessing
 import re
 import time
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -28,7 +28,22 @@ from cellstress.sim.layout import M_STEP, M_T
 from cellstress.sim.simulator import Simulator
 from cellstress.verifier.arrival import ArrivalCover, arrival_cover, confirm_phases, inflated
 from cellstress.verifier.bounds import Bounds
-from cellstress.verifier.phases import StartPoint, arrival_phases, phases_are_grid, start_points
+from cellstress.verifier.checkpoint import (
+    CHECKPOINT,
+    CheckpointWriter,
+    DecidedLine,
+    FoundLine,
+    head_of,
+    read_checkpoint,
+    remove_checkpoint,
+)
+from cellstress.verifier.phases import (
+    StartPoint,
+    arrival_phases,
+    chosen_starts,
+    parse_phases,
+    phases_are_grid,
+)
 from cellstress.verifier.records import (
     PROVED_SAFE,
     UNDECIDED,
@@ -193,40 +208,86 @@ def tasks_of(sim: Simulator, options: VerifyOptions, deadline: float | None, cov
     """The sub-trees of a verification, in the order of the result."""
     window = cover.half_window if cover.covered and options.moments == "all" and \
         phases_are_grid(sim.cell, options.phases) else 0.0
-    return [Task(sim.cell, s, p, options, deadline, cover, window) for s in start_points(sim.cell)
-            for p in arrival_phases(sim, s, options.phases)]
+    return [Task(sim.cell, s, p, options, deadline, cover, window) for s in chosen_starts(sim.cell, options.starts)
+            for p in arrival_phases(sim, s, options.phases, options.window)]
+
+
+def _line(d: Decided) -> DecidedLine:
+    """A decided sub-tree as its checkpoint line (``verifier.checkpoint``)."""
+    return DecidedLine(task=0, subtree=d.subtree,
+                       found=tuple(FoundLine(key=f.key, actions=tuple(int(a) for a in f.actions), step=int(f.step),
+                                             time_s=float(f.time_s), sequences=int(f.sequences), phase=float(f.phase))
+                                   for f in d.found))
+
+
+def _decided(line: DecidedLine) -> Decided:
+    return Decided(line.subtree, tuple(Found(tuple(f.key), tuple(f.actions), f.step, f.time_s, f.sequences, f.phase)
+                                       for f in line.found))
 
 
 def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out: str | Path | None = None,
                progress: Callable[[int, int], None] | None = None,
-               static_failures: tuple[StaticFailure, ...] = ()) -> VerifyResult:
+               static_failures: tuple[StaticFailure, ...] = (),
+               resumed: Callable[[int, int], None] | None = None) -> VerifyResult:
     """Decide ``sim``'s cell (see ``cellstress.api.verify``). ``progress(sequences decided, of)``; ``out``: a folder
-    for ``verify.json`` and one witness per hazard class (``witness-NN/result.json``)."""
+    for ``verify.json`` and one witness per hazard class (``witness-NN/result.json``), and for the checkpoint of
+    the sub-trees decided so far (``verifier.checkpoint``), from which a stopped run resumes;
+    ``resumed(sub-trees taken from it, of)`` is called once when it held some."""
     cell = sim.cell
     _SIMS[(cell.sha256, cell.spec.criterion.type, "")] = sim
     deadline = None if options.time_limit is None else time.time() + options.time_limit
     cover = arrival_cover(sim, sim.contacts is not None)
     tasks = tasks_of(sim, options, deadline, cover)
     total = len(tasks) * N_ACTIONS ** options.horizon
-    done = [0]
+    journal = None if out is None else Path(out) / CHECKPOINT
+    head = head_of(cell.sha256, cell.spec.criterion.type, options, len(tasks), __version__)
+    done: dict[int, Decided] = {}
+    if journal is not None:
+        journal.parent.mkdir(parents=True, exist_ok=True)
+        done = {i: _decided(line) for i, line in
+                read_checkpoint(journal, head, [(t.start.name, t.phase) for t in tasks]).items()}
+        if done and resumed is not None:
+            resumed(len(done), len(tasks))
+    decided_sequences = [sum(d.subtree.sequences for d in done.values())]
 
     def tick(n: int) -> None:
-        done[0] += n
+        decided_sequences[0] += n
         if progress is not None:
-            progress(done[0], total)
+            progress(decided_sequences[0], total)
 
-    workers = min(workers, len(tasks))  # never a process without a sub-tree to decide
-    if workers <= 1:
-        decided = [decide_task(t, tick) for t in tasks]
-    else:
-        # spawned, not forked: numba's thread pool in this process makes a fork unsafe
-        with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
-                                 initializer=_init_worker) as pool:
-            futures = [pool.submit(decide_task, t) for t in tasks]
-            for f in futures:
-                f.add_done_callback(lambda f: tick(f.result().subtree.sequences) if not f.exception() else None)
-            decided = [f.result() for f in futures]
-    return assemble(sim, options, tasks, decided, out, static_failures)
+    if done:
+        tick(0)
+    todo = [i for i in range(len(tasks)) if i not in done]
+    writer = None if journal is None else CheckpointWriter(journal, head)
+    try:
+        if min(workers, len(todo)) <= 1:
+            for i in todo:
+                done[i] = decide_task(tasks[i], tick)
+                if writer is not None:
+                    writer.add(i, _line(done[i]))
+        else:
+            # spawned, not forked: numba's thread pool in this process makes a fork unsafe. Never a process without
+            # a sub-tree to decide.
+            with ProcessPoolExecutor(max_workers=min(workers, len(todo)), initializer=_init_worker,
+                                     mp_context=multiprocessing.get_context("spawn")) as pool:
+                futures = {pool.submit(decide_task, tasks[i]): i for i in todo}
+                try:
+                    for f in as_completed(futures):
+                        i = futures[f]
+                        done[i] = f.result()
+                        if writer is not None:
+                            writer.add(i, _line(done[i]))
+                        tick(done[i].subtree.sequences)
+                except BaseException:
+                    pool.shutdown(wait=True, cancel_futures=True)  # the sub-trees under way finish; none begins
+                    raise
+    finally:
+        if writer is not None:
+            writer.close()
+    result = assemble(sim, options, tasks, [done[i] for i in range(len(tasks))], out, static_failures)
+    if journal is not None and not result.undecided:
+        remove_checkpoint(journal)
+    return result
 
 
 def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided: list[Decided],
@@ -302,13 +363,22 @@ def check_witness_folders(out: Path) -> None:
 
 
 def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "all", moments: str = "all",
+                starts: tuple[str, ...] | None = None,
                 time_limit: float | None = None, bounds: tuple[str, ...] | None = None, workers: int = 1,
                 out: str | Path | None = None, progress: Callable[[int, int], None] | None = None,
-                static_failures: tuple[StaticFailure, ...] = ()) -> VerifyResult:
-    """``run_verify`` with its options checked: VerifyError (a user error) for a bad one. ``static_failures``: the
-    cell's failing ``check`` rows (``cellstress.analysis.check_rows.static_failures``), kept in the result."""
-    fields: dict[str, Any] = {"horizon": sim.actions_per_episode if horizon is None else horizon, "phases": phases,
-                              "moments": moments}
+                static_failures: tuple[StaticFailure, ...] = (),
+                resumed: Callable[[int, int], None] | None = None) -> VerifyResult:
+    """``run_verify`` with its options checked: VerifyError (a user error) for a bad one. ``phases``: ``all``,
+    ``cell`` or a window ``A:B`` [s] of the robot's cycle; ``starts``: the start points to decide (None: every
+    one). ``static_failures``: the cell's failing ``check`` rows (``cellstress.analysis.check_rows
+    .static_failures``), kept in the result."""
+    try:
+        mode, window = parse_phases(phases)
+        fields: dict[str, Any] = {"horizon": sim.actions_per_episode if horizon is None else horizon,
+                                  "phases": mode, "moments": moments, "window": window,
+                                  "starts": tuple(starts or ())}
+    except ValueError as exc:
+        raise VerifyError(str(exc)) from None
     if time_limit is not None:
         fields["time_limit"] = time_limit
     if bounds is not None:
@@ -317,10 +387,13 @@ def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "al
         options = VerifyOptions.model_validate(fields, strict=False)
     except ValidationError as exc:
         e = exc.errors(include_url=False)[0]
-        raise VerifyError(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}") from None
+        where = ".".join(str(p) for p in e["loc"])
+        raise VerifyError(f"{where + ': ' if where else ''}{e['msg'].removeprefix('Value error, ')}") from None
     try:
         check_workers(workers, "workers")
-    except CellstressError as exc:
+        for s in chosen_starts(sim.cell, options.starts):
+            arrival_phases(sim, s, options.phases, options.window)
+    except (CellstressError, ValueError) as exc:
         raise VerifyError(str(exc)) from None
     if out is not None:
         check_witness_folders(Path(out))
@@ -328,4 +401,5 @@ def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "al
         # its bounds are the paper worker's (30 actions, reach volumes on rigid shoulders: docs/verify.md)
         raise VerifyError(f"verify proves cells with the paper's worker only; this cell's is "
                           f"{sim.cell.spec.human.model!r} (human.model)")
-    return run_verify(sim, options, workers=workers, out=out, progress=progress, static_failures=static_failures)
+    return run_verify(sim, options, workers=workers, out=out, progress=progress, static_failures=static_failures,
+                      resumed=resumed)

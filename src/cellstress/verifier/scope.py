@@ -31,8 +31,13 @@ def arrival_text(options: VerifyOptions, cover: ArrivalCover, grid: bool, phases
     if not grid:
         moments = ", ".join(f"{p:g} s" for p in phases[:6]) + (", ..." if len(phases) > 6 else "")
         return f"the cell's fixed arrival moment{'s' if len(phases) > 1 else ''} only ({moments})", False
-    span = f"{len(phases)} grid moments {dt:g} s apart over the robot's {cycle:g} s cycle" \
-        if options.phases == "all" else f"{len(phases)} grid moments {dt:g} s apart in the cell's arrival window"
+    if options.phases == "all":
+        span = f"{len(phases)} grid moments {dt:g} s apart over the robot's {cycle:g} s cycle"
+    elif options.phases == "window":
+        a, b = options.window
+        span = f"{len(phases)} grid moments {dt:g} s apart from {a:g} to {b:g} s of the robot's {cycle:g} s cycle"
+    else:
+        span = f"{len(phases)} grid moments {dt:g} s apart in the cell's arrival window"
     if options.moments == "grid":
         return f"the {span} only (--moments grid)", False
     if not cover.covered:
