@@ -737,6 +737,21 @@ OPTIONS: list[Case] = [
       for kind, setup, says in (("link", _link("out/witness-01", "../in"), "is a symbolic link"),
                                 ("file", _write("out/witness-01", b"mine\n"), "is not a folder"),
                                 ("dangling-link", _link("out/witness-01", "../nowhere"), "is a symbolic link"))),
+    # issue 31: verify's checkpoint in --out is an input like any other; its options refuse markup and nonsense
+    *(Case(f"verify-checkpoint-{kind}", ("verify", "baseline", "--phases", "cell", "--horizon", "1", "--workers", "1",
+                                        "--out", "out"), 2, ("verify-checkpoint.jsonl", says),
+           setup=setup, group=f"verify-checkpoint-{kind}")
+      for kind, setup, says in (("link", _link("out/verify-checkpoint.jsonl", "../in/victim.txt"), "symbolic link"),
+                                ("fifo", _fifo("out/verify-checkpoint.jsonl"), "not a regular file"),
+                                ("garbage", _write("out/verify-checkpoint.jsonl", b"\x00\xff{[\n"), "line 1"),
+                                ("foreign", _write("out/verify-checkpoint.jsonl", b'{"kind": "cellstress verify '
+                                                   b'checkpoint", "cell_sha256": "0", "criterion": "x", "options": {}, '
+                                                   b'"tasks": 1, "version": "0"}\n'), "another verification"))),
+    Case("verify-phases-nan", ("verify", "baseline", "--phases", "nan:1", "--out", "out"), 2, ("phases", "finite")),
+    Case("verify-phases-huge", ("verify", "baseline", "--phases", "1e300:1e301", "--out", "out"), 2,
+         ("phases", "no arrival phase")),
+    Case("verify-starts-markup", ("verify", "baseline", "--starts", "<script>\x1b[31m", "--out", "out"), 2,
+         ("starts",)),
     *(Case(f"campaign-manifest-{name}", ("campaign", "--cells", "baseline", "--searchers", "random", "--seeds", "1",
                                         "--budget", "2", "--workers", "1", "--out", "out"), 2, ("campaign.json", *says),
            setup=setup, group=f"campaign-manifest-{name}")
