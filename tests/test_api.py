@@ -21,7 +21,8 @@ DOC = (Path(__file__).resolve().parents[1] / "docs" / "api.md").read_text(encodi
                 "options"]),
     ("simulate", ["cell", "actions", "criterion"]),
     ("write_report", ["result", "out"]),
-    ("verify", ["cell", "horizon", "phases", "moments", "time_limit", "workers", "out", "criterion", "progress"]),
+    ("verify", ["cell", "horizon", "phases", "moments", "time_limit", "workers", "out", "criterion", "progress",
+                "starts", "backend", "address"]),
 ])
 def test_functions_have_real_signatures(name, params) -> None:
     func = getattr(cellstress, name)

@@ -90,11 +90,13 @@ def write_report(result: SearchResult | str | Path, out: str | Path | None = Non
 
 
 def verify(cell: CellLike, *, horizon: int | None = None, phases: str = "all", moments: str = "all",
-           time_limit: float | None = None, workers: int = 1, out: str | Path | None = None,
-           criterion: str | None = None, progress: Callable[[int, int], None] | None = None) -> VerifyResult:
+           time_limit: float | None = None, workers: int | None = 1, out: str | Path | None = None,
+           criterion: str | None = None, progress: Callable[[int, int], None] | None = None,
+           starts: Sequence[str] | None = None, backend: str = "processes", address: str | None = None) -> VerifyResult:
     """Decide exactly whether any sequence of ``horizon`` worker actions (default: the cell's
-    ``actions_per_episode``) reaches the unsafe set, from every start point, at every arrival phase of the robot's
-    cycle on the time-step grid (``phases="all"``) or at the cell's own phases (``"cell"``); with
+    ``actions_per_episode``) reaches the unsafe set, from every start point (or those named in ``starts``), at every
+    arrival phase of the robot's cycle on the time-step grid (``phases="all"``), at the cell's own phases
+    (``"cell"``) or at the grid phases of a window (``"A:B"``, seconds of the cycle); with
     ``moments="all"`` each grid phase also stands for the arrival moments within half a step of it where the cell
     allows it (``"grid"``: the grid alone). ``.scope`` says exactly what the verdict covers.
 
@@ -102,8 +104,10 @@ def verify(cell: CellLike, *, horizon: int | None = None, phases: str = "all", m
     ``.hazardous`` the exact number of hazardous sequences, per sub-tree in ``.subtrees``; ``.classes`` one witness
     per hazard class; ``.static_failures`` the rows ``check`` fails, which a proof of the simulated worker does not
     clear (each says what that worker cannot do there, if anything). ``workers`` processes decide sub-trees in
-    parallel; ``out``: a folder for verify.json and the witnesses' replayable result files. docs/verify.md says
-    what a proof means."""
+    parallel (``backend="ray"``: Ray tasks, on the cluster at ``address`` or a local one; the same result);
+    ``out``: a folder for verify.json, the witnesses' replayable result files and the checkpoint a stopped run
+    resumes from. docs/verify.md says what a proof means."""
     sim = Simulator(_cell(cell, criterion))
     return verify_cell(sim, horizon=horizon, phases=phases, moments=moments, time_limit=time_limit, workers=workers,
-                       out=out, progress=progress, static_failures=static_failures(check_cell(sim.cell)))
+                       out=out, progress=progress, static_failures=static_failures(check_cell(sim.cell)),
+                       starts=None if starts is None else tuple(starts), backend=backend, address=address)

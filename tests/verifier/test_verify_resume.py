@@ -145,3 +145,33 @@ def test_a_foreign_or_damaged_checkpoint_is_refused(whole, tmp_path, capsys, cha
     assert code == 2 and len(err) == 1 and err[0].startswith("error: ") and words in err[0], err
     assert CHECKPOINT in err[0] and not (out / "verify.json").exists()
     json.loads(lines[0])  # (the head is JSON: the refusal is about its content)
+
+
+def test_on_ray_the_same_bytes_and_resumes_from_a_local_run(whole, tmp_path):
+    """Interrupted on local processes, finished as Ray tasks on a local Ray: the bytes of one uninterrupted local
+    run (a sub-tree is a pure function of its task; the order of the result does not depend on who finished
+    first)."""
+    pytest.importorskip("ray")
+    cell, expected = whole
+    out = tmp_path / "out"
+
+    def stop(done: int, total: int) -> None:
+        if done >= 10 * 30 ** HORIZON:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        cellstress.verify(cell, horizon=HORIZON, phases=PHASES, out=out, progress=stop)
+    res = cellstress.verify(cell, horizon=HORIZON, phases=PHASES, out=out, backend="ray", workers=2)
+    assert res.verdict == "UNSAFE" and (out / "verify.json").read_bytes() == expected
+    assert not (out / CHECKPOINT).exists()
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--backend", "cloud"], "--backend must be one of processes, ray"),
+    (["--address", "10.0.0.1:6379"], "--address is the address of a Ray cluster"),
+    (["--backend", "ray", "--workers", "0"], "--workers must be a whole number in 1..100000"),
+])
+def test_a_bad_backend_is_one_line_before_anything_is_written(tmp_path, capsys, args, words):
+    code = main(["verify", "baseline", "--horizon", "1", *args, "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and words in err[0] and not (tmp_path / "out").exists(), err

@@ -15,12 +15,12 @@ from dataclasses import dataclass
 from typing import Any
 
 from cellstress.campaign.plan import CampaignError, RunSpec
-from cellstress.campaign.worker import execute, execute_threaded, init_worker
+from cellstress.campaign.worker import execute, execute_on_one_thread, init_worker
 from cellstress.core.cpus import check_workers, usable_cpus
 from cellstress.core.errors import CellstressError
+from cellstress.core.ray_pool import import_ray, ray_map
 
 BACKENDS = ("processes", "ray")
-RAY_HINT = "pip install 'cellstress[ray]'"
 MAX_RAY_TASKS = 100_000
 
 
@@ -52,7 +52,7 @@ class Backend:
     def check(self) -> None:
         """Fail early (before the --out folder is touched) when the backend cannot run here."""
         if self.name == "ray":
-            _ray()
+            import_ray(CampaignError)
 
     def describe(self, n_runs: int) -> str:
         if self.name == "ray":
@@ -101,48 +101,8 @@ def run_processes(specs: list[RunSpec], workers: int) -> Iterator[dict[str, Any]
                 f.cancel()
 
 
-def _ray():
-    try:
-        import ray
-    except ImportError:
-        raise CampaignError(f"--backend ray needs Ray, which is not installed ({RAY_HINT})") from None
-    return ray
-
-
 def run_ray(specs: list[RunSpec], max_in_flight: int | None, address: str | None) -> Iterator[dict[str, Any]]:
-    """Ray tasks of one CPU each. Joins the cluster at ``address``; without one, uses the Ray this process
-    already joined, or starts a local Ray on this machine's cores (and stops it afterwards)."""
-    import logging
-
-    ray = _ray()
-    started = False
-    if not ray.is_initialized():
-        kwargs: dict[str, Any] = {"address": address, "include_dashboard": False,
-                                  "logging_level": logging.WARNING}
-        if address is None:
-            kwargs["num_cpus"] = max_in_flight or usable_cpus()
-        try:
-            ray.init(**kwargs)
-        except (ConnectionError, ValueError, RuntimeError) as exc:
-            raise CampaignError(f"--address {address}: cannot join the Ray cluster ({exc})") from None
-        started = True
-    task = ray.remote(num_cpus=1)(execute_threaded)
-    limit = max_in_flight or len(specs)
-    queue = list(reversed(specs))
-    running: list[Any] = []
-    try:
-        while queue or running:
-            while queue and len(running) < limit:
-                running.append(task.remote(queue.pop(), 1))
-            done, running = ray.wait(running, num_returns=1)
-            for ref in done:
-                try:
-                    yield ray.get(ref)
-                except ray.exceptions.RayTaskError as exc:
-                    cause = getattr(exc, "cause", None)
-                    raise cause if isinstance(cause, Exception) else exc from None
-    finally:
-        for ref in running:
-            ray.cancel(ref, force=True)
-        if started:
-            ray.shutdown()
+    """Ray tasks of one CPU each, one numba thread each (``core.ray_pool``)."""
+    for _, record in ray_map(execute_on_one_thread, specs, max_in_flight=max_in_flight, address=address,
+                             error=CampaignError):
+        yield record

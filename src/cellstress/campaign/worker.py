@@ -108,7 +108,7 @@ def execute(spec: RunSpec) -> dict[str, Any]:
     }
 
 
-def execute_threaded(spec: RunSpec, threads: int | None) -> dict[str, Any]:
-    """``execute`` for Ray tasks, which have no initializer: set the thread count first (cheap if set)."""
-    set_threads(threads)
+def execute_on_one_thread(spec: RunSpec) -> dict[str, Any]:
+    """``execute`` for Ray tasks, which have no initializer: one numba thread first (cheap if set)."""
+    set_threads(1)
     return execute(spec)

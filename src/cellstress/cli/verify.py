@@ -39,7 +39,13 @@ def verify(
     time_limit: Annotated[float | None, typer.Option("--time-limit", help="Seconds; what is not decided by "
                                                      "then is reported as undecided (exit code 3).")] = None,
     workers: Annotated[int | None, typer.Option("--workers", help="Processes deciding sub-trees in parallel "
-                                                "(default: all usable cores; at most 4 per core).")] = None,
+                                                "(default: all usable cores; at most 4 per core); with --backend "
+                                                "ray, Ray tasks at a time (default: the cluster's CPUs).")] = None,
+    backend: Annotated[str, typer.Option("--backend", help="processes: on this machine; ray: as Ray tasks, on "
+                                         "the cluster at --address or a local Ray (pip install 'cellstress[ray]'); "
+                                         "the same verify.json either way.")] = "processes",
+    address: Annotated[str | None, typer.Option("--address", help="A Ray cluster's address (--backend ray; "
+                                                "default: start a local one).")] = None,
     criterion: Annotated[str | None, typer.Option("--criterion", help=criterion_help("the cell file's"))] = None,
     junit: Annotated[str | None, typer.Option("--junit", help=JUNIT_HELP + " A test case for the verdict and a "
                                               "failing one per hazard class.")] = None,
@@ -57,17 +63,17 @@ def verify(
     from cellstress.analysis.check_rows import static_failures
     from cellstress.analysis.iso13855 import check_cell
     from cellstress.cell.load import load_cell, with_criterion
-    from cellstress.core.cpus import check_workers, usable_cpus
+    from cellstress.core.cpus import usable_cpus
     from cellstress.report.junit import verify_suite
     from cellstress.report.scope import judged_by
     from cellstress.report.verify import HTML_NAME, PNG_NAME, hazard_map, summary_lines, verify_page, witness_view
     from cellstress.sim.simulator import Simulator
     from cellstress.verifier.checkpoint import CHECKPOINT
-    from cellstress.verifier.run import verify_cell
+    from cellstress.verifier.run import check_backend, verify_cell
 
     with user_errors():
         check_criterion(criterion)
-        check_workers(workers)
+        check_backend(backend, address, workers)
     out_dir = check_out_dir(out)
     junit_path = check_junit_path(junit)
     console = Console(stderr=True)
@@ -89,7 +95,8 @@ def verify(
             sim = Simulator(with_criterion(load_cell(cell), criterion))
             res = verify_cell(sim, horizon=horizon, phases=phases, moments=moments, time_limit=time_limit,
                               starts=None if starts is None else tuple(n.strip() for n in starts.split(",")),
-                              workers=usable_cpus() if workers is None else workers, out=out_dir,
+                              workers=usable_cpus() if workers is None and backend != "ray" else workers,
+                              backend=backend, address=address, out=out_dir,
                               progress=tick, static_failures=static_failures(check_cell(sim.cell)),
                               resumed=resumed)
     except KeyboardInterrupt:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import multiprocessing
 import re
+import signal
 import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -16,9 +17,11 @@ from typing import Any
 from pydantic import ValidationError
 
 from cellstress.cell.load import Cell
-from cellstress.core.cpus import check_workers
+from cellstress.core.cpus import check_workers, usable_cpus
 from cellstress.core.errors import CellstressError
 from cellstress.core.io import OutputPathError
+from cellstress.core.jit import numba
+from cellstress.core.ray_pool import import_ray, ray_map
 from cellstress.core.version import __version__
 from cellstress.human.actions import N_ACTIONS
 from cellstress.searchers.distinct import hazard_class, hazard_class_record, root_cause
@@ -61,6 +64,8 @@ from cellstress.verifier.tree import TreeOutcome, decide
 from cellstress.verifier.witness import witness_actions, witness_severity, write_witness
 
 WITNESS_DIR = "witness-{:02d}"
+BACKENDS = ("processes", "ray")
+MAX_RAY_TASKS = 100_000
 
 
 class VerifyError(CellstressError):
@@ -195,11 +200,13 @@ def decide_task(task: Task, progress: Callable[[int], None] | None = None) -> De
     return Decided(sub, tuple(Found(*f) for f in found.values()))
 
 
+def decide_on_one_thread(task: Task) -> Decided:
+    """``decide_task`` in a Ray task, which has no initializer: one numba thread, as a local worker process."""
+    numba.set_num_threads(1)
+    return decide_task(task)
+
+
 def _init_worker() -> None:
-    import signal
-
-    from cellstress.core.jit import numba
-
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the main process handles Ctrl-C and stops the pool
     numba.set_num_threads(1)  # one thread per worker process: N workers on N cores
 
@@ -225,11 +232,14 @@ def _decided(line: DecidedLine) -> Decided:
                                        for f in line.found))
 
 
-def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out: str | Path | None = None,
+def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int | None = 1, out: str | Path | None = None,
                progress: Callable[[int, int], None] | None = None,
                static_failures: tuple[StaticFailure, ...] = (),
-               resumed: Callable[[int, int], None] | None = None) -> VerifyResult:
-    """Decide ``sim``'s cell (see ``cellstress.api.verify``). ``progress(sequences decided, of)``; ``out``: a folder
+               resumed: Callable[[int, int], None] | None = None, backend: str = "processes",
+               address: str | None = None) -> VerifyResult:
+    """Decide ``sim``'s cell (see ``cellstress.api.verify``). ``backend``: ``processes`` (``workers`` local
+    processes) or ``ray`` (``workers`` Ray tasks at a time, None: the cluster's CPUs; ``address`` of a cluster,
+    None: a local one), with the same result. ``progress(sequences decided, of)``; ``out``: a folder
     for ``verify.json`` and one witness per hazard class (``witness-NN/result.json``), and for the checkpoint of
     the sub-trees decided so far (``verifier.checkpoint``), from which a stopped run resumes;
     ``resumed(sub-trees taken from it, of)`` is called once when it held some."""
@@ -258,13 +268,25 @@ def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out:
     if done:
         tick(0)
     todo = [i for i in range(len(tasks)) if i not in done]
+    if backend != "ray" and workers is None:
+        workers = usable_cpus()
     writer = None if journal is None else CheckpointWriter(journal, head)
+
+    def keep(i: int, d: Decided) -> None:
+        done[i] = d
+        if writer is not None:
+            writer.add(i, _line(d))
+
     try:
-        if min(workers, len(todo)) <= 1:
+        if backend == "ray":
+            # workers: Ray tasks at a time (None: as many as the cluster has CPUs)
+            for k, d in ray_map(decide_on_one_thread, [tasks[i] for i in todo], max_in_flight=workers,
+                                address=address, error=VerifyError):
+                keep(todo[k], d)
+                tick(d.subtree.sequences)
+        elif min(workers or 1, len(todo)) <= 1:
             for i in todo:
-                done[i] = decide_task(tasks[i], tick)
-                if writer is not None:
-                    writer.add(i, _line(done[i]))
+                keep(i, decide_task(tasks[i], tick))
         else:
             # spawned, not forked: numba's thread pool in this process makes a fork unsafe. Never a process without
             # a sub-tree to decide.
@@ -273,11 +295,8 @@ def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int = 1, out:
                 futures = {pool.submit(decide_task, tasks[i]): i for i in todo}
                 try:
                     for f in as_completed(futures):
-                        i = futures[f]
-                        done[i] = f.result()
-                        if writer is not None:
-                            writer.add(i, _line(done[i]))
-                        tick(done[i].subtree.sequences)
+                        keep(futures[f], f.result())
+                        tick(done[futures[f]].subtree.sequences)
                 except BaseException:
                     pool.shutdown(wait=True, cancel_futures=True)  # the sub-trees under way finish; none begins
                     raise
@@ -362,16 +381,36 @@ def check_witness_folders(out: Path) -> None:
                                   f"inside its output folder {out} (remove it, or use another folder)")
 
 
+def check_backend(backend: str, address: str | None, workers: int | None) -> None:
+    """VerifyError (one line) for a backend, cluster address or number of workers that cannot be used here."""
+    if backend not in BACKENDS:
+        raise VerifyError(f"--backend must be one of {', '.join(BACKENDS)}, not {backend[:40]!r}")
+    if address is not None and backend != "ray":
+        raise VerifyError("--address is the address of a Ray cluster: use it with --backend ray")
+    if backend == "ray":
+        import_ray(VerifyError)
+        if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                    or not 1 <= workers <= MAX_RAY_TASKS):
+            raise VerifyError(f"--workers must be a whole number in 1..{MAX_RAY_TASKS} (Ray tasks at a time), not "
+                              f"{workers!r}")
+        return
+    try:
+        check_workers(workers, "--workers")
+    except CellstressError as exc:
+        raise VerifyError(str(exc)) from None
+
+
 def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "all", moments: str = "all",
                 starts: tuple[str, ...] | None = None,
-                time_limit: float | None = None, bounds: tuple[str, ...] | None = None, workers: int = 1,
+                time_limit: float | None = None, bounds: tuple[str, ...] | None = None, workers: int | None = 1,
                 out: str | Path | None = None, progress: Callable[[int, int], None] | None = None,
                 static_failures: tuple[StaticFailure, ...] = (),
-                resumed: Callable[[int, int], None] | None = None) -> VerifyResult:
+                resumed: Callable[[int, int], None] | None = None, backend: str = "processes",
+                address: str | None = None) -> VerifyResult:
     """``run_verify`` with its options checked: VerifyError (a user error) for a bad one. ``phases``: ``all``,
     ``cell`` or a window ``A:B`` [s] of the robot's cycle; ``starts``: the start points to decide (None: every
     one). ``static_failures``: the cell's failing ``check`` rows (``cellstress.analysis.check_rows
-    .static_failures``), kept in the result."""
+    .static_failures``), kept in the result. ``backend``, ``address``: as ``run_verify``."""
     try:
         mode, window = parse_phases(phases)
         fields: dict[str, Any] = {"horizon": sim.actions_per_episode if horizon is None else horizon,
@@ -389,8 +428,8 @@ def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "al
         e = exc.errors(include_url=False)[0]
         where = ".".join(str(p) for p in e["loc"])
         raise VerifyError(f"{where + ': ' if where else ''}{e['msg'].removeprefix('Value error, ')}") from None
+    check_backend(backend, address, workers)
     try:
-        check_workers(workers, "workers")
         for s in chosen_starts(sim.cell, options.starts):
             arrival_phases(sim, s, options.phases, options.window)
     except (CellstressError, ValueError) as exc:
@@ -402,4 +441,4 @@ def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "al
         raise VerifyError(f"verify proves cells with the paper's worker only; this cell's is "
                           f"{sim.cell.spec.human.model!r} (human.model)")
     return run_verify(sim, options, workers=workers, out=out, progress=progress, static_failures=static_failures,
-                      resumed=resumed)
+                      resumed=resumed, backend=backend, address=address)
