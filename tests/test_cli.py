@@ -379,11 +379,13 @@ def test_a_proof_and_a_search_keep_the_rows_check_fails(capsys, tmp_path) -> Non
     saved = json.loads((tmp_path / "v" / "verify.json").read_text())
     assert [f["name"] for f in saved["static_failures"]] == ["whole-body-opening"]
     assert "cannot crawl" in (tmp_path / "v" / "verify.html").read_text()
-    code, out, _ = _run(["search", str(cell), "--searcher", "random", "--budget", "2", "--no-report",
-                         "--out", str(tmp_path / "s")], capsys)
+    code, out, _ = _run(["search", str(cell), "--searcher", "random", "--budget", "2", "--out", str(tmp_path / "s")],
+                        capsys)
     assert code == 0 and "no hazard found" in out
     assert any(ln.startswith("static    check FAILs whole-body-opening") and "this search does not cover" in ln
                for ln in out.splitlines())
+    page = (tmp_path / "s" / "report.html").read_text()
+    assert "check FAILs whole-body-opening" in page and "cannot crawl" in page
     # the baseline passes check: nothing to keep
     code, out, _ = _run(["verify", "baseline", "--horizon", "1", "--phases", "cell", "--workers", "1",
                          "--out", str(tmp_path / "b")], capsys)

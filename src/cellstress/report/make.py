@@ -7,6 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from cellstress.analysis.check_rows import static_failures
 from cellstress.analysis.iso13855 import check_cell
 from cellstress.analysis.shortfall import shortfall
 from cellstress.core.errors import CellstressError
@@ -18,7 +19,7 @@ from cellstress.report.episode import EpisodeView, episode_of
 from cellstress.report.hazard import StillOptions, contact_figure, risk_figure, topview_figure
 from cellstress.report.program import program_figure
 from cellstress.report.scene3d import view_of_episodes, view_of_program
-from cellstress.report.scope import NOT_A_PROOF, judged_by, search_scope, strongest_contact
+from cellstress.report.scope import NOT_A_PROOF, judged_by, search_scope, static_lines, strongest_contact
 from cellstress.report.story import Account, account
 from cellstress.report.view3d import STYLE as VIEW3D_STYLE
 from cellstress.report.view3d import view_fragment, view_page
@@ -104,9 +105,11 @@ def write_report(result: SearchResult | str | Path, out_dir: str | Path | None =
     changed = sim.cell.sha256 != res.cell.sha256 or (  # or a file it reads (a URDF, a mesh; issue 29)
         res.cell.files is not None and bool(file_changes(res.cell.files, sim.cell.files)))
     strongest = None if res.found else strongest_contact(sim, view.actions)
-    why = None if not res.found or res.hazard.why is None else shortfall(res.hazard.why, check_cell(sim.cell))
+    static = check_cell(sim.cell) if not res.found or res.hazard.why is not None else None
+    why = None if not res.found or res.hazard.why is None else shortfall(res.hazard.why, static)
     page = hazard_page(res, view, acc, top, contact, gif, risk, changed, Judgement(
-        judged_by(sim.criterion), search_scope(res, sim.cell.spec, sim.layout.trajectory.cycle), strongest, why),
+        judged_by(sim.criterion), search_scope(res, sim.cell.spec, sim.layout.trajectory.cycle), strongest, why,
+        () if res.found else static_lines(static_failures(static), "this search")),
         program, view3d=_view3d(view) if options.view3d else "")
     html = H.write_page(out / NAMES[5], page)
     return ReportFiles(top, contact, gif, risk, program, html, acc, res.found, changed)
@@ -147,6 +150,7 @@ class Judgement:
     scope: str
     strongest: str | None = None
     why: str | None = None  # a hazard: why the safeguards did not prevent it (analysis.shortfall)
+    static: tuple[str, ...] = ()  # no hazard: the rows check fails, which the search did not clear (scope.static_lines)
 
 
 def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, contact: Path, gif: Path,
@@ -177,6 +181,7 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
                     f"({e(res.searcher)}, seed {res.seed}), judged by {e(judgement.criterion)}.<br>"
                     f"Searched: {e(judgement.scope)}.<br>{e(NOT_A_PROOF)}<br>The riskiest episode kept "
                     f"(episode {view.episode}) is shown instead.{strongest}</div>")
+        body += [f'<p class="warn">{e(line.removeprefix("static").strip())}</p>' for line in judgement.static]
     if cell_changed:
         body.append('<p class="warn">The cell file, or a file it reads, has changed since the search (sha256 '
                     "differs; cellstress replay names it): the pictures show the episode replayed in the current "
