@@ -1,0 +1,236 @@
+"""``cellstress fix``: candidate changes (``analysis.remedies``), each re-checked and re-tested, with its cost.
+
+A candidate is **kept** when the changed cell passes ``check`` (every row) and its re-test finds nothing:
+
+* ``verify`` at the cell's horizon, ``--phases cell --moments grid`` (the cell's own arrival moments, grid
+  moments only), one worker process, within ``time_limit`` seconds: PROVED-SAFE keeps it, UNSAFE drops it;
+* where verify cannot decide (UNDECIDED at the time limit, a horizon over verify's 12, the articulated worker):
+  the search ``plan`` over ``budget`` episodes, ``--until budget --distinct`` with ``seed``: no hazard keeps it
+  (a search is not a proof, and the row says "search").
+
+Cost, the ranking (cheapest first, docs/fix.md): cycle time added [s], then floor area added [m^2] (the floor
+rectangle of the cell file), then parts added, then the candidate's order of generation (settings, moves of
+the device alone, moves with the cell, slowing). Times are wall-clock and kept out of every file: the
+same inputs give the same bytes unless a verify ends within a hair of the time limit on one run and not another.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from cellstress.analysis.check_rows import CheckRow, check_rows
+from cellstress.analysis.iso13855 import StaticCheck, check_cell
+from cellstress.analysis.program_check import check_programs
+from cellstress.analysis.remedies import (
+    ROUNDS,
+    Remedy,
+    device_move,
+    moved,
+    setting_remedies,
+    slowed,
+    speed_fields,
+)
+from cellstress.cell.load import Cell, parse_cell
+from cellstress.core.errors import CellstressError
+from cellstress.core.io import atomic_write_text
+from cellstress.searchers import search
+from cellstress.sim.build import build_layout
+from cellstress.sim.simulator import Simulator
+from cellstress.verifier.run import VerifyError, verify_cell
+
+MAX_VERIFY_HORIZON = 12  # verify's own limit
+SPEED_STEPS = 6  # bisection steps on the speed factor: its bracket is 1/64 of the speed wide at the end
+SEARCHER = "plan"
+
+
+@dataclass(frozen=True)
+class Retest:
+    """How a cell was re-tested and what that found."""
+
+    method: str  # 'verify' or 'search'
+    hazards: int  # hazard classes found (verify: its classes; search: distinct classes)
+    proved: bool  # verify PROVED-SAFE
+    words: str  # e.g. 'verify horizon 8, cell phases, grid moments: PROVED-SAFE'
+
+
+@dataclass(frozen=True)
+class Checked:
+    rows: tuple[CheckRow, ...]
+    cycle: float  # s, the longest robot cycle
+    floor: float  # m^2, the floor rectangle's area
+
+    @property
+    def failing(self) -> tuple[str, ...]:
+        return tuple(r.name for r in self.rows if not r.ok)
+
+
+@dataclass(frozen=True)
+class Proposal:
+    """One candidate, its cost and its verdict after."""
+
+    number: int  # the candidate's file number (candidate-N.yaml)
+    kind: str
+    change: str
+    answers: tuple[str, ...]
+    cycle_added: float  # s
+    floor_added: float  # m^2
+    parts_added: int
+    failing_after: tuple[str, ...]  # check rows still failing
+    retest: Retest | None  # None when check failed (no re-test run)
+    kept: bool
+    text: str  # the changed cell file
+
+    @property
+    def cost(self) -> tuple[float, float, int, int]:
+        return (round(self.cycle_added, 6), round(self.floor_added, 6), self.parts_added, self.number)
+
+
+@dataclass(frozen=True)
+class FixResult:
+    cell: str
+    failing_before: tuple[str, ...]
+    retest_before: Retest | None  # None when check failed (the original is not re-tested)
+    budget: int
+    seed: int
+    time_limit: float
+    candidates: tuple[Proposal, ...]  # in the order tried
+
+    @property
+    def needs_nothing(self) -> bool:
+        return not self.failing_before and self.retest_before is not None and self.retest_before.hazards == 0
+
+    @property
+    def kept(self) -> tuple[Proposal, ...]:
+        """The proposals that work, cheapest first."""
+        return tuple(sorted((p for p in self.candidates if p.kept), key=lambda p: p.cost))
+
+    @property
+    def exit_code(self) -> int:
+        return 0 if self.needs_nothing or self.kept else 1
+
+
+# ---- check and re-test -------------------------------------------------------------------------------------
+def checked(cell: Cell) -> tuple[Checked, StaticCheck]:
+    layout = build_layout(cell)
+    static, programs = check_cell(cell, layout), check_programs(layout)
+    f = cell.spec.floor
+    cycle = max((p.cycle for p in programs), default=0.0)
+    return Checked(check_rows(static, programs), cycle, (f.xmax - f.xmin) * (f.ymax - f.ymin)), static
+
+
+def retest(cell: Cell, budget: int, seed: int, time_limit: float) -> Retest:
+    """verify where it decides within ``time_limit``, else the search (module docstring)."""
+    sim = Simulator(cell)
+    horizon = sim.actions_per_episode
+    why = ""
+    if horizon > MAX_VERIFY_HORIZON:
+        why = f"horizon {horizon} > verify's {MAX_VERIFY_HORIZON}"
+    else:
+        try:
+            res = verify_cell(sim, phases="cell", moments="grid", time_limit=time_limit, workers=1)
+        except VerifyError as exc:
+            why = str(exc)
+        else:
+            if res.verdict != "UNDECIDED":
+                proved = res.verdict == "PROVED-SAFE"
+                return Retest("verify", len(res.classes), proved,
+                              f"verify horizon {horizon}, cell phases, grid moments: {res.verdict}"
+                              + ("" if proved else f" ({len(res.classes)} hazard classes)"))
+            why = f"verify undecided within {time_limit:g} s"
+    res = search(sim, SEARCHER, budget, seed, until="budget", distinct=True)
+    n = len(res.distinct or ())
+    return Retest("search", n, False, f"search {SEARCHER}, {budget} episodes, seed {seed} ({why}): "
+                  + (f"{n} hazard classes" if n else "no hazard found (not a proof)"))
+
+
+# ---- the candidates ----------------------------------------------------------------------------------------
+def _parse(remedy: Remedy, path: Path) -> Cell:
+    """The candidate written to ``path`` and read back as any cell file is."""
+    atomic_write_text(path, remedy.text)
+    return parse_cell(remedy.text, str(path), path.resolve().parent)
+
+
+def _move_remedy(cell: Cell, static: StaticCheck, whole: bool, scratch: Path) -> Remedy | None:
+    """Move every short device, re-measure, repeat (ROUNDS at most): the moves that make every ISO 13855
+    device row pass, or the last tried."""
+    moves: list = []
+    current = static
+    for _ in range(ROUNDS):
+        new = [m for d in current.devices if (m := device_move(d)) is not None]
+        if not new:
+            break
+        moves += new
+        remedy = moved(cell, tuple(moves), whole)
+        try:
+            c = _parse(remedy, scratch)
+        except CellstressError:
+            return remedy  # the check below reports it as failing
+        current = checked(c)[1]
+    return moved(cell, tuple(moves), whole) if moves else None
+
+
+def _speed_remedy(cell: Cell, base: Checked, budget: int, seed: int, time_limit: float, scratch: Path) \
+        -> Remedy | None:
+    """The largest factor on the speed scales (bisection, the search as the judge of each step; the kept factor
+    is re-tested like every candidate) at which check passes and the search finds nothing."""
+    if not speed_fields(cell):
+        return None
+    lo, hi = 0.0, 1.0
+    for _ in range(SPEED_STEPS):
+        mid = (lo + hi) / 2
+        try:
+            c = _parse(slowed(cell, mid), scratch)
+        except CellstressError:
+            hi = mid
+            continue
+        ok = not checked(c)[0].failing and not search(Simulator(c), SEARCHER, budget, seed, until="budget",
+                                                      distinct=True).distinct
+        lo, hi = (mid, hi) if ok else (lo, mid)
+    return slowed(cell, lo) if lo > 0 else None
+
+
+def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit: float = 30.0) -> FixResult:
+    """Every candidate for ``cell``, each written to ``out``/candidate-N.yaml, checked and re-tested."""
+    base, static = checked(cell)
+    before = None if base.failing else retest(cell, budget, seed, time_limit)
+    result = FixResult(cell.spec.name, base.failing, before, budget, seed, time_limit, ())
+    if result.needs_nothing:
+        return result
+    scratch = out / "scratch.yaml"
+    remedies: list[Remedy] = []
+    if base.failing:
+        remedies += setting_remedies(cell, static)
+        for whole in (False, True):
+            r = _move_remedy(cell, static, whole, scratch)
+            if r is not None and r.text not in {x.text for x in remedies}:
+                remedies.append(r)
+    else:
+        r = _speed_remedy(cell, base, budget, seed, time_limit, scratch)
+        if r is not None:
+            remedies.append(r)
+    if scratch.exists():
+        scratch.unlink()
+    proposals = tuple(_evaluate(i + 1, r, base, out, budget, seed, time_limit) for i, r in enumerate(remedies))
+    return replace(result, candidates=proposals)
+
+
+def _evaluate(number: int, r: Remedy, base: Checked, out: Path, budget: int, seed: int, time_limit: float) \
+        -> Proposal:
+    path = out / f"candidate-{number}.yaml"
+    try:
+        c = _parse(r, path)
+    except CellstressError as exc:
+        return Proposal(number, r.kind, r.change, r.rows, 0.0, 0.0, r.parts_added, (f"invalid: {exc}",), None,
+                        False, r.text)
+    after, _ = checked(c)
+    test = None if after.failing else retest(c, budget, seed, time_limit)
+    kept = not after.failing and test is not None and test.hazards == 0
+    return Proposal(number, r.kind, r.change, r.rows, _tidy(after.cycle - base.cycle),
+                    _tidy(after.floor - base.floor), r.parts_added, after.failing, test, kept, r.text)
+
+
+def _tidy(x: float) -> float:
+    x = round(x, 6)
+    return 0.0 if math.isclose(x, 0.0, abs_tol=1e-9) else x
