@@ -8,10 +8,12 @@ A candidate is **kept** when the changed cell passes ``check`` (every row) and i
   the search ``plan`` over ``budget`` episodes, ``--until budget --distinct`` with ``seed``: no hazard keeps it
   (a search is not a proof, and the row says "search").
 
-Cost, the ranking (cheapest first, docs/fix.md): cycle time added [s], then floor area added [m^2] (the floor
-rectangle of the cell file), then parts added, then the candidate's order of generation (settings, moves of
-the device alone, moves with the cell, slowing). Times are wall-clock and kept out of every file: the
-same inputs give the same bytes unless a verify ends within a hair of the time limit on one run and not another.
+Cost, the ranking (cheapest first, docs/fix.md): cycle time added [s], then floor area added [m^2] (the cell's
+footprint: the convex hull of its fences and devices), then parts added, then the order the candidates were
+tried in (settings named by rows, the device moved alone, the device moved with the cell, slowing). A move
+that passes check while its re-test still finds a hazard is tried again ``EXTRA`` metres further. Wall-clock
+time is kept out of every file: the same inputs give the same bytes, unless a verify ends within a hair of
+the time limit on one run and not on another.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from cellstress.analysis.iso13855 import StaticCheck, check_cell
 from cellstress.analysis.program_check import check_programs
 from cellstress.analysis.remedies import (
     ROUNDS,
+    Move,
     Remedy,
     device_move,
     moved,
@@ -43,6 +46,7 @@ from cellstress.verifier.run import VerifyError, verify_cell
 MAX_VERIFY_HORIZON = 12  # verify's own limit
 SPEED_STEPS = 6  # bisection steps on the speed factor: its bracket is 1/64 of the speed wide at the end
 SEARCHER = "plan"
+EXTRA = (0.1, 0.2, 0.4)  # m beyond ISO 13855 tried in turn where a move passes check and the re-test finds a hazard
 
 
 @dataclass(frozen=True)
@@ -59,7 +63,7 @@ class Retest:
 class Checked:
     rows: tuple[CheckRow, ...]
     cycle: float  # s, the longest robot cycle
-    floor: float  # m^2, the floor rectangle's area
+    footprint: float  # m^2, the cell's footprint (``footprint``)
 
     @property
     def failing(self) -> tuple[str, ...]:
@@ -115,9 +119,44 @@ class FixResult:
 def checked(cell: Cell) -> tuple[Checked, StaticCheck]:
     layout = build_layout(cell)
     static, programs = check_cell(cell, layout), check_programs(layout)
-    f = cell.spec.floor
     cycle = max((p.cycle for p in programs), default=0.0)
-    return Checked(check_rows(static, programs), cycle, (f.xmax - f.xmin) * (f.ymax - f.ymin)), static
+    return Checked(check_rows(static, programs), cycle, footprint(cell)), static
+
+
+def footprint(cell: Cell) -> float:
+    """The floor area the cell takes [m^2]: the convex hull of its fences' points and its devices' outlines
+    (fields, curtain and door lines, warning fields), what a layout change moves; the floor rectangle of the
+    file is only the simulated area and is not counted."""
+    pts: list[tuple[float, float]] = []
+    for f in cell.spec.fences:
+        pts += [tuple(p) for p in f.points]
+    for d in cell.spec.devices:
+        for key in ("start", "end"):
+            if getattr(d, key, None) is not None:
+                pts.append(tuple(getattr(d, key)))
+        pts += [tuple(p) for p in getattr(d, "polygon", None) or ()]
+        warning = getattr(d, "warning", None)
+        pts += [tuple(p) for p in getattr(warning, "polygon", None) or ()]
+    return hull_area(pts)
+
+
+def hull_area(points: list[tuple[float, float]]) -> float:
+    """Area of the convex hull (Andrew's monotone chain, then the shoelace formula); 0 for fewer than 3 points."""
+    pts = sorted(set((float(x), float(y)) for x, y in points))
+    if len(pts) < 3:
+        return 0.0
+
+    def half(seq):
+        out: list[tuple[float, float]] = []
+        for p in seq:
+            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
+                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 0:
+                out.pop()
+            out.append(p)
+        return out
+
+    hull = half(pts)[:-1] + half(reversed(pts))[:-1]
+    return abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(hull, hull[1:] + hull[:1], strict=True))) / 2
 
 
 def retest(cell: Cell, budget: int, seed: int, time_limit: float) -> Retest:
@@ -152,23 +191,22 @@ def _parse(remedy: Remedy, path: Path) -> Cell:
     return parse_cell(remedy.text, str(path), path.resolve().parent)
 
 
-def _move_remedy(cell: Cell, static: StaticCheck, whole: bool, scratch: Path) -> Remedy | None:
+def _moves(cell: Cell, static: StaticCheck, whole: bool, scratch: Path) -> tuple[Move, ...]:
     """Move every short device, re-measure, repeat (ROUNDS at most): the moves that make every ISO 13855
     device row pass, or the last tried."""
-    moves: list = []
+    moves: list[Move] = []
     current = static
     for _ in range(ROUNDS):
         new = [m for d in current.devices if (m := device_move(d)) is not None]
         if not new:
             break
         moves += new
-        remedy = moved(cell, tuple(moves), whole)
         try:
-            c = _parse(remedy, scratch)
+            c = _parse(moved(cell, tuple(moves), whole), scratch)
         except CellstressError:
-            return remedy  # the check below reports it as failing
+            break  # the candidate's own evaluation reports it
         current = checked(c)[1]
-    return moved(cell, tuple(moves), whole) if moves else None
+    return tuple(moves)
 
 
 def _speed_remedy(cell: Cell, base: Checked, budget: int, seed: int, time_limit: float, scratch: Path) \
@@ -199,21 +237,30 @@ def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit
     if result.needs_nothing:
         return result
     scratch = out / "scratch.yaml"
-    remedies: list[Remedy] = []
+    proposals: list[Proposal] = []
+
+    def evaluate(r: Remedy) -> Proposal:
+        proposals.append(_evaluate(len(proposals) + 1, r, base, out, budget, seed, time_limit))
+        return proposals[-1]
+
     if base.failing:
-        remedies += setting_remedies(cell, static)
+        for r in setting_remedies(cell, static):
+            evaluate(r)
         for whole in (False, True):
-            r = _move_remedy(cell, static, whole, scratch)
-            if r is not None and r.text not in {x.text for x in remedies}:
-                remedies.append(r)
+            moves = _moves(cell, static, whole, scratch)
+            for extra in (0.0, *EXTRA):
+                if not moves:
+                    break
+                p = evaluate(moved(cell, moves, whole, extra))
+                if p.failing_after or p.kept:  # more room helps only where check passes and a hazard remains
+                    break
     else:
         r = _speed_remedy(cell, base, budget, seed, time_limit, scratch)
         if r is not None:
-            remedies.append(r)
+            evaluate(r)
     if scratch.exists():
         scratch.unlink()
-    proposals = tuple(_evaluate(i + 1, r, base, out, budget, seed, time_limit) for i, r in enumerate(remedies))
-    return replace(result, candidates=proposals)
+    return replace(result, candidates=tuple(proposals))
 
 
 def _evaluate(number: int, r: Remedy, base: Checked, out: Path, budget: int, seed: int, time_limit: float) \
@@ -228,7 +275,7 @@ def _evaluate(number: int, r: Remedy, base: Checked, out: Path, budget: int, see
     test = None if after.failing else retest(c, budget, seed, time_limit)
     kept = not after.failing and test is not None and test.hazards == 0
     return Proposal(number, r.kind, r.change, r.rows, _tidy(after.cycle - base.cycle),
-                    _tidy(after.floor - base.floor), r.parts_added, after.failing, test, kept, r.text)
+                    _tidy(after.footprint - base.footprint), r.parts_added, after.failing, test, kept, r.text)
 
 
 def _tidy(x: float) -> float:

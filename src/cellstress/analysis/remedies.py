@@ -6,8 +6,9 @@ looks at the cell's name: the built-in flawed cells and their fixed twins are th
 * **move**: a device whose ISO 13855 distance falls short (``DeviceCheck.actual < required``) gets the entry
   edge nearest the hazard zone moved straight away from it by the shortfall plus ``MARGIN``, rounded up to the
   centimetre. Two variants: ``device`` moves only the device's own points on or beyond that edge's line;
-  ``cell`` stretches the whole cell beyond that line (fence points, every device's points, the worker's start
-  points and the floor's edge), so walls that ended at the old edge follow it and the cell stays closed. The
+  ``cell`` stretches the whole cell beyond that line (fence points and every device's points), so walls that
+  ended at the old edge follow it and the cell stays closed; in both the worker's start points beyond the line
+  move with it and the floor grows by the move (a start inside the moved field would test nothing). The
   check decides which works; ``fix`` keeps both when both do and ranks them by cost.
 * **settings** named by a failing row: ``guard_locking: true`` on a guard door whose ISO 13855 row fails,
   ``restart: manual`` for a ``DEVICE-restart`` row, the muting's ``until`` set to the pallet's end for a
@@ -21,7 +22,7 @@ from __future__ import annotations
 import copy
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import yaml
@@ -147,17 +148,19 @@ def _shift_device(dev: dict, m: Move, warning: bool) -> None:
 
 
 def apply_move(doc: dict, m: Move, whole: bool) -> None:
-    """Move the edge in ``doc`` (in place): the device alone, or the whole cell beyond the edge's line."""
+    """Move the edge in ``doc`` (in place): the device alone, or the whole cell beyond the edge's line. The
+    worker's start points beyond the line move in both: a start left inside the moved field would have the
+    worker seen from the first step, a test of nothing."""
     if not whole:
         dev = _device(doc, m.device)
         if dev is not None:
             _shift_device(dev, m, warning=False)
-        return
-    for dev in _devices(doc):
-        _shift_device(dev, m, warning=True)
-    for fence in doc.get("fences") or ():
-        if isinstance(fence, dict) and isinstance(fence.get("points"), list):
-            fence["points"] = [_shift(p, m) for p in fence["points"]]
+    else:
+        for dev in _devices(doc):
+            _shift_device(dev, m, warning=True)
+        for fence in doc.get("fences") or ():
+            if isinstance(fence, dict) and isinstance(fence.get("points"), list):
+                fence["points"] = [_shift(p, m) for p in fence["points"]]
     human = doc.get("human") or {}
     for start in [human.get("start"), *(human.get("starts") or ())]:
         if isinstance(start, dict) and isinstance(start.get("xy"), list):
@@ -173,7 +176,7 @@ def apply_move(doc: dict, m: Move, whole: bool) -> None:
 
 def move_words(m: Move, whole: bool) -> str:
     (x0, y0), (x1, y1) = m.edge
-    what = "and the cell beyond it (walls, other devices, start, floor)" if whole else "(the device alone)"
+    what = "with the cell beyond it (walls, other devices)" if whole else "(the device alone)"
     return (f"move {m.device}'s edge ({x0:g}, {y0:g})-({x1:g}, {y1:g}) {m.delta:.2f} m outward, direction "
             f"({m.normal[0]:.3g}, {m.normal[1]:.3g}), {what}")
 
@@ -265,8 +268,10 @@ def _scaled(s, factor: float) -> float:
     return max(1e-4, math.floor(float(s) * factor * 1e4) / 1e4)
 
 
-def moved(cell: Cell, moves: tuple[Move, ...], whole: bool) -> Remedy:
-    """The cell with ``moves`` applied one after the other."""
+def moved(cell: Cell, moves: tuple[Move, ...], whole: bool, extra: float = 0.0) -> Remedy:
+    """The cell with ``moves`` applied one after the other, each ``extra`` metres further than ISO 13855 needs
+    (where the check passes and the re-test still finds a hazard, ``analysis.fix`` tries larger ones)."""
+    moves = tuple(replace(m, delta=round(m.delta + extra, 6)) for m in moves)
     doc = cell_document(cell)
     for m in moves:
         apply_move(doc, m, whole)
