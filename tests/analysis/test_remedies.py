@@ -4,17 +4,27 @@ the moves follow the geometry the way the fixed twins do."""
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from cellstress.analysis.fix import _moves, checked, footprint, hull_area
-from cellstress.analysis.remedies import MARGIN, cell_document, device_move, moved, setting_remedies, slowed
+from cellstress.analysis.remedies import (
+    MARGIN,
+    cell_document,
+    device_move,
+    moved,
+    panel_move,
+    setting_remedies,
+    slowed,
+)
 from cellstress.cell.load import load_cell, parse_cell
 
 # flawed cell -> the kind of remedy that makes its check pass (a move, or the setting its failing row names)
 FLAWED = {"s1-scanner-width": "move-device", "mat-short": "move-device", "long-gripper": "move-cell",
           "palletizing": "move-cell", "warning-field-short": "move-device", "door-unlocked": "guard-locking",
           "restart-auto": "manual-restart", "muting-long": "muting-end", "two-robots": "wire",
-          "ssm-latency": "ssm-times"}
+          "ssm-latency": "ssm-times", "reach-over": "move-cell"}
 
 
 def _remedies(name, tmp_path, kinds=("settings", "move-device", "move-cell")):
@@ -72,6 +82,22 @@ def test_moving_with_the_cell_stretches_the_walls_as_the_twin_does(tmp_path):
         for p, q in zip(a.points, b.points, strict=True):
             assert q[1] == pytest.approx(p[1] + (0.4 if p[1] >= 3.2 - 1e-9 else 0.0))
     assert new.floor.ymax == pytest.approx(cell.spec.floor.ymax + 0.4)
+
+
+def test_a_fence_panel_moves_as_reach_over_ok_moved_it(tmp_path):
+    """reach-over: the 1.4 m front panel 0.44 m from the swept zone, Table 2 asks 1.1 m; reach-over-ok moved it
+    0.7 m to the front (y = 2.25) with the side walls. The panel move: towards the worker (+y), c - distance +
+    0.05 m rounded up to the cm, the side walls' ends with it."""
+    cell = load_cell("reach-over")
+    _, static = checked(cell)
+    (pr,) = static.approach.reach_over_fails
+    m = panel_move(pr)
+    assert m.normal == (0.0, 1.0)
+    assert m.delta == pytest.approx(math.ceil((pr.reach.required - pr.reach.behind + MARGIN) * 100) / 100)
+    assert 0.6 < m.delta < 0.8
+    new = parse_cell(moved(cell, (m,), False).text, "x.yaml", tmp_path).spec
+    assert new.fences[0].points == ((-1.5, 1.55 + m.delta), (1.5, 1.55 + m.delta))
+    assert new.fences[1].points[0] == (-1.5, 1.55 + m.delta) and new.fences[1].points[1] == (-1.5, -1.6)
 
 
 def test_a_safe_cell_gets_no_candidate(tmp_path):

@@ -31,6 +31,7 @@ from cellstress.analysis.remedies import (
     Remedy,
     device_move,
     moved,
+    panel_move,
     setting_remedies,
     slowed,
     speed_fields,
@@ -198,6 +199,9 @@ def _moves(cell: Cell, static: StaticCheck, whole: bool, scratch: Path) -> tuple
     current = static
     for _ in range(ROUNDS):
         new = [m for d in current.devices if (m := device_move(d)) is not None]
+        if whole:  # a fence panel too close for ISO 13857 Table 2 moves with the walls that meet it
+            panels = [pr for a in (current.approach, *current.robot_approaches) for pr in a.reach_over_fails]
+            new += list({m.line: m for pr in panels if (m := panel_move(pr)) is not None}.values())
         if not new:
             break
         moves += new

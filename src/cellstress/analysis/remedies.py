@@ -95,7 +95,7 @@ def _device(doc: dict, name: str) -> dict | None:
 class Move:
     """An edge's line moved along its outward normal: points p with n.p >= line move by delta * n."""
 
-    device: str
+    device: str  # the device's name, or 'fence F panel P' (only ever moved with the cell)
     edge: tuple[tuple[float, float], tuple[float, float]]
     normal: tuple[float, float]
     line: float
@@ -120,6 +120,22 @@ def device_move(d: DeviceCheck) -> Move | None:
     n = (round(n[0], 12) + 0.0, round(n[1], 12) + 0.0)
     delta = math.ceil((d.required - d.actual + MARGIN) * 100.0 - 1e-9) / 100.0
     return Move(d.device, edge, n, n[0] * x0 + n[1] * y0, delta)
+
+
+def panel_move(pr) -> Move | None:
+    """How far to move a fence panel that fails ISO 13857 Table 2 (an ``ApproachCheck.reach_over_fails`` item)
+    towards the worker's side so that the hazard zone lies Table 2's c behind its top (plus ``MARGIN``)."""
+    reach, panel = pr.reach, pr.panel
+    if reach.ok or not reach.side or not (math.isfinite(reach.required) and math.isfinite(reach.behind)):
+        return None
+    (x0, y0), (x1, y1) = panel.start, panel.end
+    length = math.hypot(x1 - x0, y1 - y0)
+    if length < 1e-9:
+        return None
+    n = (reach.side * -(y1 - y0) / length, reach.side * (x1 - x0) / length)
+    n = (round(n[0], 12) + 0.0, round(n[1], 12) + 0.0)
+    delta = math.ceil((reach.required - reach.behind + MARGIN) * 100.0 - 1e-9) / 100.0
+    return Move(panel.name, ((x0, y0), (x1, y1)), n, n[0] * x0 + n[1] * y0, delta)
 
 
 def _nearest_entry(d: DeviceCheck):
@@ -147,10 +163,15 @@ def _shift_device(dev: dict, m: Move, warning: bool) -> None:
         warn["polygon"] = [_shift(p, m) for p in warn["polygon"]]
 
 
+def _is_panel(m: Move) -> bool:
+    return m.device.startswith("fence ") and " panel " in m.device
+
+
 def apply_move(doc: dict, m: Move, whole: bool) -> None:
     """Move the edge in ``doc`` (in place): the device alone, or the whole cell beyond the edge's line. The
     worker's start points beyond the line move in both: a start left inside the moved field would have the
     worker seen from the first step, a test of nothing."""
+    whole = whole or _is_panel(m)
     if not whole:
         dev = _device(doc, m.device)
         if dev is not None:
@@ -176,6 +197,9 @@ def apply_move(doc: dict, m: Move, whole: bool) -> None:
 
 def move_words(m: Move, whole: bool) -> str:
     (x0, y0), (x1, y1) = m.edge
+    if _is_panel(m):
+        return (f"move {m.device} ({x0:g}, {y0:g})-({x1:g}, {y1:g}) {m.delta:.2f} m towards the worker (ISO 13857 "
+                f"Table 2), direction ({m.normal[0]:.3g}, {m.normal[1]:.3g}), with the cell beyond it")
     what = "with the cell beyond it (walls, other devices)" if whole else "(the device alone)"
     return (f"move {m.device}'s edge ({x0:g}, {y0:g})-({x1:g}, {y1:g}) {m.delta:.2f} m outward, direction "
             f"({m.normal[0]:.3g}, {m.normal[1]:.3g}), {what}")
