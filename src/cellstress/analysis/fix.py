@@ -36,6 +36,7 @@ from cellstress.analysis.remedies import (
     slowed,
     speed_fields,
 )
+from cellstress.analysis.safe_speed import MoveSpeed, move_speeds, per_move_remedy
 from cellstress.cell.load import Cell, parse_cell
 from cellstress.core.errors import CellstressError
 from cellstress.core.io import atomic_write_text
@@ -101,6 +102,8 @@ class FixResult:
     seed: int
     time_limit: float
     candidates: tuple[Proposal, ...]  # in the order tried
+    criterion: str = ""  # the criterion every re-test judged by
+    speeds: tuple[MoveSpeed, ...] = ()  # --criterion iso15066: each move's largest safe speed scale
 
     @property
     def needs_nothing(self) -> bool:
@@ -233,14 +236,19 @@ def _speed_remedy(cell: Cell, base: Checked, budget: int, seed: int, time_limit:
     return slowed(cell, lo) if lo > 0 else None
 
 
-def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit: float = 30.0) -> FixResult:
-    """Every candidate for ``cell``, each written to ``out``/candidate-N.yaml, checked and re-tested."""
+def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit: float = 30.0,
+             safe_speeds: bool = False) -> FixResult:
+    """Every candidate for ``cell``, each written to ``out``/candidate-N.yaml, checked and re-tested;
+    ``safe_speeds``: also each move's largest safe speed (``analysis.safe_speed``) and, where a move must slow
+    down, the program at those speeds as a candidate."""
     base, static = checked(cell)
     before = None if base.failing else retest(cell, budget, seed, time_limit)
-    result = FixResult(cell.spec.name, base.failing, before, budget, seed, time_limit, ())
+    scratch = out / "scratch.yaml"
+    speeds = move_speeds(cell, budget, seed, scratch) if safe_speeds else ()
+    result = FixResult(cell.spec.name, base.failing, before, budget, seed, time_limit, (),
+                       cell.spec.criterion.type, speeds)
     if result.needs_nothing:
         return result
-    scratch = out / "scratch.yaml"
     proposals: list[Proposal] = []
 
     def evaluate(r: Remedy) -> Proposal:
@@ -262,6 +270,9 @@ def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit
         r = _speed_remedy(cell, base, budget, seed, time_limit, scratch)
         if r is not None:
             evaluate(r)
+    per_move = per_move_remedy(cell, speeds)
+    if per_move is not None:
+        evaluate(per_move)
     if scratch.exists():
         scratch.unlink()
     return replace(result, candidates=tuple(proposals))

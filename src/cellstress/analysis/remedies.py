@@ -51,12 +51,15 @@ class Remedy:
 # ---- the cell file as data --------------------------------------------------------------------------------
 def cell_document(cell: Cell) -> dict:
     """The cell file's YAML mapping as written (built-in or file), with every file it reads made absolute, so a
-    changed copy written elsewhere reads the same robot, trajectory and stopping data."""
+    changed copy written elsewhere reads the same robot, trajectory and stopping data, and with the criterion
+    ``cell`` is judged by."""
     if cell.directory is None:
         text = builtin_text(cell.source)
     else:
         text = read_input_bytes(Path(cell.source).expanduser()).decode("utf-8")
     doc = safe_load_yaml(text)
+    # the criterion the cell is judged by here (``--criterion`` may differ from the file's), written out whole
+    doc["criterion"] = cell.spec.criterion.model_dump(mode="json")
     base = cell.files_dir
     for robot in _robots(doc):
         _absolute(robot, "urdf", base)
@@ -302,3 +305,31 @@ def moved(cell: Cell, moves: tuple[Move, ...], whole: bool, extra: float = 0.0) 
     rows = tuple(dict.fromkeys(m.device for m in moves))
     return Remedy("move-cell" if whole else "move-device", "; ".join(move_words(m, whole) for m in moves), rows, 0,
                   _dump(doc))
+
+
+def program_moves(cell: Cell) -> tuple[tuple[int, int, float], ...]:
+    """Every move of every robot program that has a speed field: (robot index, move index, its speed scale)."""
+    out = []
+    for k, r in enumerate(_robots(cell_document(cell))):
+        task = r.get("task") or {}
+        if task.get("trajectory_csv"):
+            continue
+        n = len(task.get("waypoints_deg") or task.get("poses") or ())
+        scales = task.get("speed_scales") or [task.get("speed_scale", 0.5)] * n
+        out += [(k, i, float(scales[i])) for i in range(n)]
+    return tuple(out)
+
+
+def with_scales(cell: Cell, scales: dict[tuple[int, int], float], words: str) -> Remedy:
+    """The cell with the given moves' speed scales (robot index, move index) -> scale; other moves unchanged."""
+    doc = cell_document(cell)
+    for k, r in enumerate(_robots(doc)):
+        task = r.get("task")
+        if not isinstance(task, dict) or task.get("trajectory_csv"):
+            continue
+        n = len(task.get("waypoints_deg") or task.get("poses") or ())
+        old = task.pop("speed_scales", None) or [task.get("speed_scale", 0.5)] * n
+        task.pop("speed_scale", None)
+        task["speed_scales"] = [max(0.01, math.floor(scales.get((k, i), float(old[i])) * 1e4) / 1e4)
+                                for i in range(n)]
+    return Remedy("slow-per-move", words, ("hazard",), 0, _dump(doc))

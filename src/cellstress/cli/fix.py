@@ -9,8 +9,10 @@ import typer
 from cellstress.cli.common import (
     CELL_HELP,
     JUNIT_HELP,
+    check_criterion,
     check_junit_path,
     check_out_dir,
+    criterion_help,
     fail,
     say,
     spinner_while_compiling,
@@ -29,6 +31,9 @@ def fix(
     seed: Annotated[int, typer.Option("--seed", help="Seed (>= 0) of that search.")] = 0,
     time_limit: Annotated[float, typer.Option("--time-limit", help="Seconds verify may take on one candidate "
                                               "before the search re-tests it instead.")] = 30.0,
+    criterion: Annotated[str | None, typer.Option("--criterion", help=criterion_help("the cell file's") + " With "
+                                                  "iso15066, also each move's largest safe speed (docs/fix.md).")]
+        = None,
     junit: Annotated[str | None, typer.Option("--junit", help=JUNIT_HELP + " One test case per candidate and one "
                                               "for the verdict.")] = None,
 ) -> None:
@@ -44,21 +49,22 @@ def fix(
     from rich.console import Console
 
     from cellstress.analysis.fix import fix_cell
-    from cellstress.cell.load import load_cell
+    from cellstress.cell.load import load_cell, with_criterion
     from cellstress.core.io import atomic_write_text
     from cellstress.report.fix import fix_json, fix_page, fix_suite, print_fix
     from cellstress.searchers.common import check_common
 
     with user_errors():
         check_common(budget, seed, "budget", 10)
+        check_criterion(criterion)
     if not (math.isfinite(time_limit) and 0 < time_limit <= 3600):
         raise fail(f"--time-limit {time_limit:g}: give seconds between 0 and 3600")
     junit_path = check_junit_path(junit)
     with user_errors():
-        loaded = load_cell(cell)
+        loaded = with_criterion(load_cell(cell), criterion)
     out_dir = check_out_dir(out)
     with spinner_while_compiling(), user_errors():
-        res = fix_cell(loaded, out_dir, budget, seed, time_limit)
+        res = fix_cell(loaded, out_dir, budget, seed, time_limit, safe_speeds=loaded.spec.criterion.type == "iso15066")
     print_fix(res, Console(highlight=False, soft_wrap=False))
     try:
         for old in sorted(Path(out_dir).glob("proposal-*.yaml")):

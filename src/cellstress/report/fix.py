@@ -36,6 +36,19 @@ def _rows(r: FixResult) -> list[list[str]]:
              f"{p.floor_added:+.2f}", str(p.parts_added), _verdict(p), _how(p.retest)] for p in order]
 
 
+SPEED_COLUMNS = ("robot", "move", "speed scale", "largest safe scale")
+
+
+def _speed_rows(r: FixResult) -> list[list[str]]:
+    return [[str(m.robot + 1), str(m.move + 1), f"{m.original:g}",
+             f"{m.safe:.4g}" if m.safe > 0 else "none (a hazard at 1/64)"] for m in r.speeds]
+
+
+def speed_title(r: FixResult) -> str:
+    return (f"largest safe speed per move under {r.criterion} (search plan, {r.budget} episodes, seed {r.seed}; "
+            "the other moves crawling; a search that finds nothing is not a proof)")
+
+
 def summary(r: FixResult) -> str:
     if r.needs_nothing:
         return f"NOTHING TO FIX: {r.cell} fails no check row and its re-test found nothing ({_how(r.retest_before)})"
@@ -63,6 +76,13 @@ def print_fix(r: FixResult, console) -> None:
         grid.add_row(*(t(v) for v in row))
     if r.candidates:
         console.print(grid)
+    if r.speeds:
+        speeds = Table(title=for_terminal(speed_title(r)), title_justify="left")
+        for col in SPEED_COLUMNS:
+            speeds.add_column(col)
+        for row in _speed_rows(r):
+            speeds.add_row(*(t(v) for v in row))
+        console.print(speeds)
     console.print(t(summary(r)))
 
 
@@ -78,7 +98,9 @@ def fix_json(r: FixResult) -> str:
         "cell": r.cell, "exit_code": r.exit_code, "needs_nothing": r.needs_nothing,
         "failing_before": list(r.failing_before), "retest_before": _retest_doc(r.retest_before),
         "options": {"budget": r.budget, "seed": r.seed, "time_limit": r.time_limit},
-        "cost_order": COST_ORDER,
+        "cost_order": COST_ORDER, "criterion": r.criterion,
+        "move_speeds": [{"robot": m.robot + 1, "move": m.move + 1, "speed_scale": m.original, "safe_scale": m.safe}
+                        for m in r.speeds],
         "candidates": [{"candidate": p.number, "proposal": kept.get(p.number), "kind": p.kind, "change": p.change,
                         "answers": list(p.answers), "cycle_added_s": p.cycle_added, "floor_added_m2": p.floor_added,
                         "parts_added": p.parts_added, "failing_after": list(p.failing_after),
@@ -97,6 +119,8 @@ def fix_page(r: FixResult) -> str:
             "nothing is not a proof.</p>"]
     if r.candidates:
         body.append(table(list(COLUMNS), _rows(r), numeric={0, 2, 3, 4}))
+    if r.speeds:
+        body += [f"<h2>{escape(speed_title(r))}</h2>", table(list(SPEED_COLUMNS), _speed_rows(r), numeric={0, 1, 2})]
     return page(f"cellstress fix {r.cell}", body, "cellstress fix: every kept proposal is proposal-N.yaml, "
                 "numbered in the order of cost")
 
