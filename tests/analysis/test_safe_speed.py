@@ -31,8 +31,8 @@ def test_a_trajectory_file_has_no_speed_to_scale():
 
 
 def test_the_safe_baseline_is_safe_at_full_scale_on_every_move(tmp_path):
-    """The baseline's scanner stops the robot before any contact: every move's first try (scale 1.0) finds
-    nothing, so the bisection is not needed (two searches of 10 episodes)."""
+    """The baseline's scanner stops the robot before any contact: the program's first try (every move at scale
+    1.0) and each move's find nothing, so no bisection is needed (three searches of 10 episodes)."""
     cell = with_criterion(load_cell("baseline"), "iso15066")
     speeds = move_speeds(cell, 10, 0, tmp_path / "scratch.yaml")
     assert [(s.move, s.safe) for s in speeds] == [(0, 1.0), (1, 1.0)]

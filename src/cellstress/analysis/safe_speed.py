@@ -1,13 +1,17 @@
 """The maximum safe speed per move (``cellstress fix --criterion iso15066``): for each move of each robot's
 program, the largest speed scale at which the search finds no contact over the body region's ISO/TS 15066 limit.
 
-Each move is measured on its own: the move under test runs at the scale being tried and every other move of
-every robot crawls at ``CRAWL`` (so a contact elsewhere in the cycle does not decide this move's number); a
-bisection of ``STEPS`` steps on (0, 1] with the search (``plan``, ``--until budget --distinct``, the given
-budget and seed) as the judge: a scale is safe when the search finds no hazard under the cell's criterion.
-The program with every move at its safe scale is then a candidate like any other (``analysis.fix``: re-checked,
-re-tested by verify or the search together), with the cycle time it costs. A search that finds nothing is no
-proof, and a move's number is only as good as the search's budget: the table says so.
+Two steps, the search (``plan``, ``--until budget --distinct``, the given budget and seed) the judge of every
+try: a speed scale is safe when the search finds no hazard under the cell's criterion on the cell with those
+scales. First the **program's** largest scale ``s*``, every move of every robot at the same scale (1.0 tried
+first, then a bisection of ``STEPS`` steps on (0, 1)); then, **per move**, the largest scale of that move with
+every other move at ``s*`` (1.0 tried first, then a bisection between ``s*`` and 1). A move's number holds with
+the others at ``s*`` (a contact anywhere in the cycle counts against the try: the search does not say which
+move it happened in). The program with every move at the lesser of its own scale and its safe one is then a
+candidate like any other (``analysis.fix``: re-checked, re-tested as a whole), with the cycle time it costs.
+A search that finds nothing is no proof, and the numbers are only as good as the budget: the table says so.
+(A first version measured each move with the others crawling at 0.01: with the worker's arrival fixed in
+seconds, the crawling moves pushed the measured move out of every episode and every move read as safe.)
 """
 
 from __future__ import annotations
@@ -22,8 +26,7 @@ from cellstress.core.io import atomic_write_text
 from cellstress.searchers import search
 from cellstress.sim.simulator import Simulator
 
-CRAWL = 0.01  # the other moves' speed scale while one is measured (the schema's smallest)
-STEPS = 6  # bisection steps: the safe scale is found to 1/64
+STEPS = 6  # bisection steps of the program's scale (to 1/64); a move's own take 4 (1/16 of what is left)
 SEARCHER = "plan"
 
 
@@ -32,7 +35,7 @@ class MoveSpeed:
     robot: int  # index in the cell's robots
     move: int  # move i goes from waypoint i to the next (the last back to the first)
     original: float  # its speed scale in the cell
-    safe: float  # the largest scale found safe (0: none, a hazard even at 1/64)
+    safe: float  # the largest scale found safe with the other moves at the program's (0: none, even at 1/64)
 
 
 def _safe(cell: Cell, scales: dict[tuple[int, int], float], budget: int, seed: int, scratch: Path) -> bool:
@@ -45,20 +48,33 @@ def _safe(cell: Cell, scales: dict[tuple[int, int], float], budget: int, seed: i
     return not search(Simulator(c), SEARCHER, budget, seed, until="budget", distinct=True).distinct
 
 
+def _largest(ok, lo: float, steps: int) -> float:
+    """The largest x in (lo, 1] with ok(x), 1.0 tried first then bisection (``lo`` when none is found)."""
+    if ok(1.0):
+        return 1.0
+    hi = 1.0
+    for _ in range(steps):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
+    return lo
+
+
 def move_speeds(cell: Cell, budget: int, seed: int, scratch: Path) -> tuple[MoveSpeed, ...]:
     """Every move's largest safe speed scale (module docstring)."""
     moves = program_moves(cell)
+    if not moves:
+        return ()
+    keys = [(r, m) for r, m, _ in moves]
+    program = _largest(lambda x: _safe(cell, dict.fromkeys(keys, x), budget, seed, scratch), 0.0, STEPS)
     out = []
+    others = dict.fromkeys(keys, program)
     for robot, move, original in moves:
-        crawl = {(r, m): CRAWL for r, m, _ in moves if (r, m) != (robot, move)}
-        lo, hi = 0.0, 1.0
-        if _safe(cell, {**crawl, (robot, move): hi}, budget, seed, scratch):
-            lo = hi
-        else:
-            for _ in range(STEPS):
-                mid = (lo + hi) / 2
-                lo, hi = (mid, hi) if _safe(cell, {**crawl, (robot, move): mid}, budget, seed, scratch) else (lo, mid)
-        out.append(MoveSpeed(robot, move, original, lo))
+        if program <= 0:
+            out.append(MoveSpeed(robot, move, original, 0.0))
+            continue
+        safe = _largest(lambda x, k=(robot, move): _safe(cell, {**others, k: x}, budget, seed, scratch), program,
+                        STEPS - 2)
+        out.append(MoveSpeed(robot, move, original, safe))
     if scratch.exists():
         scratch.unlink()
     return tuple(out)

@@ -46,7 +46,7 @@ def _speed_rows(r: FixResult) -> list[list[str]]:
 
 def speed_title(r: FixResult) -> str:
     return (f"largest safe speed per move under {r.criterion} (search plan, {r.budget} episodes, seed {r.seed}; "
-            "the other moves crawling; a search that finds nothing is not a proof)")
+            "the other moves at the program's largest safe scale; a search that finds nothing is not a proof)")
 
 
 def summary(r: FixResult) -> str:
