@@ -16,7 +16,6 @@ from cellstress.analysis.remedies import (
     moved,
     panel_move,
     setting_remedies,
-    slowed,
 )
 from cellstress.cell.load import load_cell, parse_cell
 
@@ -103,12 +102,6 @@ def test_a_fence_panel_moves_as_reach_over_ok_moved_it(tmp_path):
 def test_a_safe_cell_gets_no_candidate(tmp_path):
     base, remedies = _remedies("baseline", tmp_path)
     assert not base.failing and remedies == []
-
-
-def test_slowing_scales_every_speed_field():
-    cell = load_cell("baseline")
-    doc = parse_cell(slowed(cell, 0.5).text, "x.yaml", None).spec
-    assert doc.robots[0].task.speed_scale == pytest.approx(cell.spec.robots[0].task.speed_scale * 0.5)
 
 
 def test_file_paths_are_made_absolute():

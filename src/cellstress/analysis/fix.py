@@ -10,7 +10,8 @@ A candidate is **kept** when the changed cell passes ``check`` (every row) and i
 
 Cost, the ranking (cheapest first, docs/fix.md): cycle time added [s], then floor area added [m^2] (the cell's
 footprint: the convex hull of its fences and devices), then parts added, then the order the candidates were
-tried in (settings named by rows, the device moved alone, the device moved with the cell, slowing). A move
+tried in (settings named by rows, the device moved alone, the device moved with the cell, the program slowed
+per move: ``analysis.safe_speed``, also where check passes and the re-test finds a hazard). A move
 that passes check while its re-test still finds a hazard is tried again ``EXTRA`` metres further. Wall-clock
 time is kept out of every file: the same inputs give the same bytes, unless a verify ends within a hair of
 the time limit on one run and not on another.
@@ -33,8 +34,6 @@ from cellstress.analysis.remedies import (
     moved,
     panel_move,
     setting_remedies,
-    slowed,
-    speed_fields,
 )
 from cellstress.analysis.safe_speed import MoveSpeed, move_speeds, per_move_remedy
 from cellstress.cell.load import Cell, parse_cell
@@ -46,7 +45,6 @@ from cellstress.sim.simulator import Simulator
 from cellstress.verifier.run import VerifyError, verify_cell
 
 MAX_VERIFY_HORIZON = 12  # verify's own limit
-SPEED_STEPS = 6  # bisection steps on the speed factor: its bracket is 1/64 of the speed wide at the end
 SEARCHER = "plan"
 EXTRA = (0.1, 0.2, 0.4)  # m beyond ISO 13855 tried in turn where a move passes check and the re-test finds a hazard
 
@@ -216,26 +214,6 @@ def _moves(cell: Cell, static: StaticCheck, whole: bool, scratch: Path) -> tuple
     return tuple(moves)
 
 
-def _speed_remedy(cell: Cell, base: Checked, budget: int, seed: int, time_limit: float, scratch: Path) \
-        -> Remedy | None:
-    """The largest factor on the speed scales (bisection, the search as the judge of each step; the kept factor
-    is re-tested like every candidate) at which check passes and the search finds nothing."""
-    if not speed_fields(cell):
-        return None
-    lo, hi = 0.0, 1.0
-    for _ in range(SPEED_STEPS):
-        mid = (lo + hi) / 2
-        try:
-            c = _parse(slowed(cell, mid), scratch)
-        except CellstressError:
-            hi = mid
-            continue
-        ok = not checked(c)[0].failing and not search(Simulator(c), SEARCHER, budget, seed, until="budget",
-                                                      distinct=True).distinct
-        lo, hi = (mid, hi) if ok else (lo, mid)
-    return slowed(cell, lo) if lo > 0 else None
-
-
 def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit: float = 30.0,
              safe_speeds: bool = False) -> FixResult:
     """Every candidate for ``cell``, each written to ``out``/candidate-N.yaml, checked and re-tested;
@@ -266,11 +244,10 @@ def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit
                 p = evaluate(moved(cell, moves, whole, extra))
                 if p.failing_after or p.kept:  # more room helps only where check passes and a hazard remains
                     break
-    else:
-        r = _speed_remedy(cell, base, budget, seed, time_limit, scratch)
-        if r is not None:
-            evaluate(r)
-    per_move = per_move_remedy(cell, speeds)
+    elif not speeds:  # check passes and the re-test found a hazard: slowing is the remedy left
+        speeds = move_speeds(cell, budget, seed, scratch)
+        result = replace(result, speeds=speeds)
+    per_move = per_move_remedy(cell, speeds, scratch)
     if per_move is not None:
         evaluate(per_move)
     if scratch.exists():

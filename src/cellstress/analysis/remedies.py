@@ -14,7 +14,7 @@ looks at the cell's name: the built-in flawed cells and their fixed twins are th
   ``restart: manual`` for a ``DEVICE-restart`` row, the muting's ``until`` set to the pallet's end for a
   ``DEVICE-muting`` row, a speed and separation controller's configured times set to the real ones its row
   names as underestimated, and a device wired to a robot whose ``undetected-reach:ROBOT`` row fails.
-* **slow**: the program's speed scale(s) multiplied by a factor (``analysis.fix`` bisects the factor).
+* **slow-per-move**: the program's speed scales, one per move (``with_scales``; ``analysis.safe_speed`` finds them).
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ class Remedy:
     """One candidate change: what it is (in words), which check rows it answers, and the whole changed cell."""
 
     kind: str  # 'move-device', 'move-cell', 'guard-locking', 'manual-restart', 'muting-end', 'ssm-times',
-    # 'wire', 'slow'
+    # 'wire', 'slow-per-move'
     change: str  # e.g. "move front-mat's edge (-1.5, 2.3)-(1.5, 2.3) 0.47 m outward (+y)"
     rows: tuple[str, ...]  # the failing check rows (or 'hazard') it answers
     parts_added: int  # new devices or fences (every remedy here adds none; the field keeps the cost honest)
@@ -270,31 +270,6 @@ def _wiring(base: dict, static: StaticCheck) -> list[Remedy]:
     return out
 
 
-# ---- slowing the robot ---------------------------------------------------------------------------------------
-def speed_fields(cell: Cell) -> int:
-    """How many robots have a speed field to scale (a waypoint or pose program; a trajectory file has none)."""
-    return sum(1 for r in _robots(cell_document(cell)) if not (r.get("task") or {}).get("trajectory_csv"))
-
-
-def slowed(cell: Cell, factor: float) -> Remedy:
-    """The cell with every robot's speed scale(s) (``speed_scale``, default 0.5, or ``speed_scales``) times
-    ``factor``, rounded down to 1e-4 (at least 1e-4)."""
-    doc = cell_document(cell)
-    for r in _robots(doc):
-        task = r.get("task")
-        if not isinstance(task, dict) or task.get("trajectory_csv"):
-            continue
-        if isinstance(task.get("speed_scales"), list):
-            task["speed_scales"] = [_scaled(s, factor) for s in task["speed_scales"]]
-        else:
-            task["speed_scale"] = _scaled(task.get("speed_scale", 0.5), factor)
-    return Remedy("slow", f"slow the robot's program to {factor:.4f} of its speed", ("hazard",), 0, _dump(doc))
-
-
-def _scaled(s, factor: float) -> float:
-    return max(1e-4, math.floor(float(s) * factor * 1e4) / 1e4)
-
-
 def moved(cell: Cell, moves: tuple[Move, ...], whole: bool, extra: float = 0.0) -> Remedy:
     """The cell with ``moves`` applied one after the other, each ``extra`` metres further than ISO 13855 needs
     (where the check passes and the re-test still finds a hazard, ``analysis.fix`` tries larger ones)."""
@@ -320,13 +295,17 @@ def program_moves(cell: Cell) -> tuple[tuple[int, int, float], ...]:
     return tuple(out)
 
 
-def with_scales(cell: Cell, scales: dict[tuple[int, int], float], words: str) -> Remedy:
-    """The cell with the given moves' speed scales (robot index, move index) -> scale; other moves unchanged."""
+def with_scales(cell: Cell, scales: dict[tuple[int, int], float], words: str,
+                phases: dict[int, float] | None = None) -> Remedy:
+    """The cell with the given moves' speed scales (robot index, move index) -> scale, other moves unchanged;
+    ``phases``: robot index -> its program's new ``phase`` (the same point of the path in the slower cycle)."""
     doc = cell_document(cell)
     for k, r in enumerate(_robots(doc)):
         task = r.get("task")
         if not isinstance(task, dict) or task.get("trajectory_csv"):
             continue
+        if phases and k in phases:
+            task["phase"] = round(phases[k], 6)
         n = len(task.get("waypoints_deg") or task.get("poses") or ())
         old = task.pop("speed_scales", None) or [task.get("speed_scale", 0.5)] * n
         task.pop("speed_scale", None)

@@ -41,12 +41,13 @@ SPEED_COLUMNS = ("robot", "move", "speed scale", "largest safe scale")
 
 def _speed_rows(r: FixResult) -> list[list[str]]:
     return [[str(m.robot + 1), str(m.move + 1), f"{m.original:g}",
-             f"{m.safe:.4g}" if m.safe > 0 else "none (a hazard at 1/64)"] for m in r.speeds]
+             f"{m.safe:.4g}" if m.safe > 0 else "none (a hazard at 1/8)"] for m in r.speeds]
 
 
 def speed_title(r: FixResult) -> str:
-    return (f"largest safe speed per move under {r.criterion} (search plan, {r.budget} episodes, seed {r.seed}; "
-            "the other moves at the program's largest safe scale; a search that finds nothing is not a proof)")
+    return (f"largest safe speed per move under {r.criterion} (scales 1/8..1 from the slowest up, each judged by "
+            f"search plan, {r.budget} episodes, seed {r.seed}; the other moves at the program's largest safe scale; "
+            "a search that finds nothing is not a proof)")
 
 
 def summary(r: FixResult) -> str:
