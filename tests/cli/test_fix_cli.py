@@ -12,6 +12,7 @@ import json
 from pathlib import Path
 
 import pytest
+from junit_schema import validate_junit
 
 from cellstress.cell.load import builtin_file
 from cellstress.cli import main
@@ -63,8 +64,11 @@ def test_hostile_name_is_escaped_in_the_page(runs):
 
 
 def test_junit_has_a_passing_verdict(runs):
-    xml = (runs[0][1].parent / "j1.xml").read_text()
-    assert 'name="fix"' in xml and "<failure" not in xml and "&lt;script&gt;" in xml
+    data = (runs[0][1].parent / "j1.xml").read_bytes()
+    root = validate_junit(data)
+    cases = {c.get("name"): c for c in root.iter("testcase")}
+    assert set(cases) == {"fix", "candidate 1: move-device", "candidate 2: move-cell"}
+    assert not list(root.iter("failure")) and b"&lt;script&gt;" in data
 
 
 def test_a_safe_cell_needs_nothing(tmp_path, capsys):
