@@ -12,7 +12,7 @@ from cellstress.core.io import canonical_json
 from cellstress.core.text import for_terminal
 from cellstress.report.html import page, table
 
-COLUMNS = ("#", "change", "cycle +s", "floor +m2", "parts +", "verdict after", "how proved")
+COLUMNS = ("file", "change", "cycle +s", "floor +m2", "parts +", "verdict after", "how proved")
 COST_ORDER = "cycle time added, then floor area added, then parts added, then the order tried"
 
 
@@ -32,7 +32,9 @@ def _how(t: Retest | None) -> str:
 
 def _rows(r: FixResult) -> list[list[str]]:
     order = [*r.kept, *(p for p in r.candidates if not p.kept)]
-    return [[str(p.number), ("KEPT " if p.kept else "dropped ") + p.change, f"{p.cycle_added:+.2f}",
+    files = {p.number: f"proposal-{i + 1}.yaml" for i, p in enumerate(r.kept)}
+    return [[files.get(p.number, f"candidate-{p.number}.yaml"), ("KEPT " if p.kept else "dropped ") + p.change,
+             f"{p.cycle_added:+.2f}",
              f"{p.floor_added:+.2f}", str(p.parts_added), _verdict(p), _how(p.retest)] for p in order]
 
 
@@ -119,7 +121,7 @@ def fix_page(r: FixResult) -> str:
             f"{r.time_limit:g} s, else the search (plan, {r.budget} episodes, seed {r.seed}); a search that finds "
             "nothing is not a proof.</p>"]
     if r.candidates:
-        body.append(table(list(COLUMNS), _rows(r), numeric={0, 2, 3, 4}))
+        body.append(table(list(COLUMNS), _rows(r), numeric={2, 3, 4}))
     if r.speeds:
         body += [f"<h2>{escape(speed_title(r))}</h2>", table(list(SPEED_COLUMNS), _speed_rows(r), numeric={0, 1, 2})]
     return page(f"cellstress fix {r.cell}", body, "cellstress fix: every kept proposal is proposal-N.yaml, "
