@@ -221,7 +221,7 @@ def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit
     down, the program at those speeds as a candidate."""
     base, static = checked(cell)
     before = None if base.failing else retest(cell, budget, seed, time_limit)
-    scratch = out / "scratch.yaml"
+    scratch = out / ".fix-scratch.yaml"  # each try written and read back as a cell file; removed at the end
     speeds = move_speeds(cell, budget, seed, scratch) if safe_speeds else ()
     result = FixResult(cell.spec.name, base.failing, before, budget, seed, time_limit, (),
                        cell.spec.criterion.type, speeds)
