@@ -85,3 +85,20 @@ def test_bad_input_is_one_error_line(args, tmp_path, capsys):
     assert main(["fix", *args, "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error:")
+
+
+def test_a_row_no_candidate_answers_exits_1(tmp_path, capsys):
+    """The baseline with its bay curtain's lowest beam raised to 0.6 m: only its crawl-under row fails, and no
+    candidate kind answers that row (docs/fix.md): exit 1, no proposal, the JUnit verdict case fails."""
+    text = Path(builtin_file("baseline")).read_text()
+    assert text.count("    bottom: 0.2") == 1
+    cell = tmp_path / "crawl.yaml"
+    cell.write_text(text.replace("    bottom: 0.2", "    bottom: 0.6"))
+    out = tmp_path / "out"
+    assert main(["fix", str(cell), "--out", str(out), *ARGS, "--junit", str(tmp_path / "j.xml")]) == 1
+    doc = json.loads((out / "fix.json").read_text())
+    assert doc["failing_before"] == ["bay-curtain-crawl-under"] and doc["candidates"] == [] and not doc["needs_nothing"]
+    assert not list(out.glob("proposal-*.yaml"))
+    root = validate_junit((tmp_path / "j.xml").read_bytes())
+    assert [c.get("name") for c in root.iter("testcase")] == ["fix"] and len(list(root.iter("failure"))) == 1
+    assert "NO PROPOSAL WORKS" in capsys.readouterr().out
