@@ -287,8 +287,8 @@ def test_help_exits_0(capsys) -> None:
     assert "simulate" in out and "check" in out and "cells" in out
 
 
-@pytest.mark.parametrize("command", ["cells", "check", "diff", "simulate", "search", "verify", "replay", "campaign",
-                                     "report", "show"])
+@pytest.mark.parametrize("command", ["cells", "check", "diff", "fix", "simulate", "search", "verify", "replay",
+                                     "campaign", "report", "show"])
 def test_command_help_names_values_plainly(capsys, command) -> None:
     """``--out OUT``, not ``--out <str>``; a flag such as ``--help`` or ``--json`` shows no value."""
     code, out, _ = _run([command, "--help"], capsys)

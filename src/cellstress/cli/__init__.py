@@ -15,6 +15,7 @@ from cellstress.cli.cells import cells
 from cellstress.cli.check import check
 from cellstress.cli.common import USER_ERROR, fail
 from cellstress.cli.diff import diff
+from cellstress.cli.fix import fix
 from cellstress.cli.new import new
 from cellstress.cli.replay import replay
 from cellstress.cli.report import report, show
@@ -31,7 +32,7 @@ app = typer.Typer(
     rich_markup_mode=None,
     help="Find hidden human-robot hazards in industrial robot cells.",
 )
-for command in (cells, check, diff, simulate, search, verify, replay, campaign, report, show, schema, new):
+for command in (cells, check, diff, fix, simulate, search, verify, replay, campaign, report, show, schema, new):
     app.command()(command)
 
 

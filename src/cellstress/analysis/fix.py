@@ -1,0 +1,275 @@
+"""``cellstress fix``: candidate changes (``analysis.remedies``), each re-checked and re-tested, with its cost.
+
+A candidate is **kept** when the changed cell passes ``check`` (every row) and its re-test finds nothing:
+
+* ``verify`` at the cell's horizon, ``--phases cell --moments grid`` (the cell's own arrival moments, grid
+  moments only), one worker process, within ``time_limit`` seconds: PROVED-SAFE keeps it, UNSAFE drops it;
+* where verify cannot decide (UNDECIDED at the time limit, a horizon over verify's 12, the articulated worker):
+  the search ``plan`` over ``budget`` episodes, ``--until budget --distinct`` with ``seed``: no hazard keeps it
+  (a search is not a proof, and the row says "search").
+
+Cost, the ranking (cheapest first, docs/fix.md): cycle time added [s], then floor area added [m^2] (the cell's
+footprint: the convex hull of its fences and devices), then parts added, then the order the candidates were
+tried in (settings named by rows, the device moved alone, the device moved with the cell, the program slowed
+per move: ``analysis.safe_speed``, also where check passes and the re-test finds a hazard). A move
+that passes check while its re-test still finds a hazard is tried again ``EXTRA`` metres further. Wall-clock
+time is kept out of every file: the same inputs give the same bytes, unless a verify ends within a hair of
+the time limit on one run and not on another.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from cellstress.analysis.check_rows import CheckRow, check_rows
+from cellstress.analysis.iso13855 import StaticCheck, check_cell
+from cellstress.analysis.program_check import check_programs
+from cellstress.analysis.remedies import (
+    ROUNDS,
+    Move,
+    Remedy,
+    device_move,
+    moved,
+    panel_move,
+    setting_remedies,
+)
+from cellstress.analysis.safe_speed import MoveSpeed, move_speeds, per_move_remedy
+from cellstress.cell.load import Cell, parse_cell
+from cellstress.core.errors import CellstressError
+from cellstress.core.io import atomic_write_text
+from cellstress.searchers import search
+from cellstress.sim.build import build_layout
+from cellstress.sim.simulator import Simulator
+from cellstress.verifier.run import VerifyError, verify_cell
+
+MAX_VERIFY_HORIZON = 12  # verify's own limit
+SEARCHER = "plan"
+EXTRA = (0.1, 0.2, 0.4)  # m beyond ISO 13855 tried in turn where a move passes check and the re-test finds a hazard
+
+
+@dataclass(frozen=True)
+class Retest:
+    """How a cell was re-tested and what that found."""
+
+    method: str  # 'verify' or 'search'
+    hazards: int  # hazard classes found (verify: its classes; search: distinct classes)
+    proved: bool  # verify PROVED-SAFE
+    words: str  # e.g. 'verify horizon 8, cell phases, grid moments: PROVED-SAFE'
+
+
+@dataclass(frozen=True)
+class Checked:
+    rows: tuple[CheckRow, ...]
+    cycle: float  # s, the longest robot cycle
+    footprint: float  # m^2, the cell's footprint (``footprint``)
+
+    @property
+    def failing(self) -> tuple[str, ...]:
+        return tuple(r.name for r in self.rows if not r.ok)
+
+
+@dataclass(frozen=True)
+class Proposal:
+    """One candidate, its cost and its verdict after."""
+
+    number: int  # the candidate's file number (candidate-N.yaml)
+    kind: str
+    change: str
+    answers: tuple[str, ...]
+    cycle_added: float  # s
+    floor_added: float  # m^2
+    parts_added: int
+    failing_after: tuple[str, ...]  # check rows still failing
+    retest: Retest | None  # None when check failed (no re-test run)
+    kept: bool
+    text: str  # the changed cell file
+
+    @property
+    def cost(self) -> tuple[float, float, int, int]:
+        return (round(self.cycle_added, 6), round(self.floor_added, 6), self.parts_added, self.number)
+
+
+@dataclass(frozen=True)
+class FixResult:
+    cell: str
+    failing_before: tuple[str, ...]
+    retest_before: Retest | None  # None when check failed (the original is not re-tested)
+    budget: int
+    seed: int
+    time_limit: float
+    candidates: tuple[Proposal, ...]  # in the order tried
+    criterion: str = ""  # the criterion every re-test judged by
+    speeds: tuple[MoveSpeed, ...] = ()  # --criterion iso15066: each move's largest safe speed scale
+
+    @property
+    def needs_nothing(self) -> bool:
+        return not self.failing_before and self.retest_before is not None and self.retest_before.hazards == 0
+
+    @property
+    def kept(self) -> tuple[Proposal, ...]:
+        """The proposals that work, cheapest first."""
+        return tuple(sorted((p for p in self.candidates if p.kept), key=lambda p: p.cost))
+
+    @property
+    def exit_code(self) -> int:
+        return 0 if self.needs_nothing or self.kept else 1
+
+
+# ---- check and re-test -------------------------------------------------------------------------------------
+def checked(cell: Cell) -> tuple[Checked, StaticCheck]:
+    layout = build_layout(cell)
+    static, programs = check_cell(cell, layout), check_programs(layout)
+    cycle = max((p.cycle for p in programs), default=0.0)
+    return Checked(check_rows(static, programs), cycle, footprint(cell)), static
+
+
+def footprint(cell: Cell) -> float:
+    """The floor area the cell takes [m^2]: the convex hull of its fences' points and its devices' outlines
+    (fields, curtain and door lines, warning fields), what a layout change moves; the floor rectangle of the
+    file is only the simulated area and is not counted."""
+    pts: list[tuple[float, float]] = []
+    for f in cell.spec.fences:
+        pts += [tuple(p) for p in f.points]
+    for d in cell.spec.devices:
+        for key in ("start", "end"):
+            if getattr(d, key, None) is not None:
+                pts.append(tuple(getattr(d, key)))
+        pts += [tuple(p) for p in getattr(d, "polygon", None) or ()]
+        warning = getattr(d, "warning", None)
+        pts += [tuple(p) for p in getattr(warning, "polygon", None) or ()]
+    return hull_area(pts)
+
+
+def hull_area(points: list[tuple[float, float]]) -> float:
+    """Area of the convex hull (Andrew's monotone chain, then the shoelace formula); 0 for fewer than 3 points."""
+    pts = sorted(set((float(x), float(y)) for x, y in points))
+    if len(pts) < 3:
+        return 0.0
+
+    def half(seq):
+        out: list[tuple[float, float]] = []
+        for p in seq:
+            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
+                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 0:
+                out.pop()
+            out.append(p)
+        return out
+
+    hull = half(pts)[:-1] + half(reversed(pts))[:-1]
+    return abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(hull, hull[1:] + hull[:1], strict=True))) / 2
+
+
+def retest(cell: Cell, budget: int, seed: int, time_limit: float) -> Retest:
+    """verify where it decides within ``time_limit``, else the search (module docstring)."""
+    sim = Simulator(cell)
+    horizon = sim.actions_per_episode
+    why = ""
+    if horizon > MAX_VERIFY_HORIZON:
+        why = f"horizon {horizon} > verify's {MAX_VERIFY_HORIZON}"
+    else:
+        try:
+            res = verify_cell(sim, phases="cell", moments="grid", time_limit=time_limit, workers=1)
+        except VerifyError as exc:
+            why = str(exc)
+        else:
+            if res.verdict != "UNDECIDED":
+                proved = res.verdict == "PROVED-SAFE"
+                return Retest("verify", len(res.classes), proved,
+                              f"verify horizon {horizon}, cell phases, grid moments: {res.verdict}"
+                              + ("" if proved else f" ({len(res.classes)} hazard classes)"))
+            why = f"verify undecided within {time_limit:g} s"
+    res = search(sim, SEARCHER, budget, seed, until="budget", distinct=True)
+    n = len(res.distinct or ())
+    return Retest("search", n, False, f"search {SEARCHER}, {budget} episodes, seed {seed} ({why}): "
+                  + (f"{n} hazard classes" if n else "no hazard found (not a proof)"))
+
+
+# ---- the candidates ----------------------------------------------------------------------------------------
+def _parse(remedy: Remedy, path: Path) -> Cell:
+    """The candidate written to ``path`` and read back as any cell file is."""
+    atomic_write_text(path, remedy.text)
+    return parse_cell(remedy.text, str(path), path.resolve().parent)
+
+
+def _moves(cell: Cell, static: StaticCheck, whole: bool, scratch: Path) -> tuple[Move, ...]:
+    """Move every short device, re-measure, repeat (ROUNDS at most): the moves that make every ISO 13855
+    device row pass, or the last tried."""
+    moves: list[Move] = []
+    current = static
+    for _ in range(ROUNDS):
+        new = [m for d in current.devices if (m := device_move(d)) is not None]
+        if whole:  # a fence panel too close for ISO 13857 Table 2 moves with the walls that meet it
+            panels = [pr for a in (current.approach, *current.robot_approaches) for pr in a.reach_over_fails]
+            new += list({m.line: m for pr in panels if (m := panel_move(pr)) is not None}.values())
+        if not new:
+            break
+        moves += new
+        try:
+            c = _parse(moved(cell, tuple(moves), whole), scratch)
+        except CellstressError:
+            break  # the candidate's own evaluation reports it
+        current = checked(c)[1]
+    return tuple(moves)
+
+
+def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit: float = 30.0,
+             safe_speeds: bool = False) -> FixResult:
+    """Every candidate for ``cell``, each written to ``out``/candidate-N.yaml, checked and re-tested;
+    ``safe_speeds``: also each move's largest safe speed (``analysis.safe_speed``) and, where a move must slow
+    down, the program at those speeds as a candidate."""
+    base, static = checked(cell)
+    before = None if base.failing else retest(cell, budget, seed, time_limit)
+    scratch = out / ".fix-scratch.yaml"  # each try written and read back as a cell file; removed at the end
+    speeds = move_speeds(cell, budget, seed, scratch) if safe_speeds else ()
+    result = FixResult(cell.spec.name, base.failing, before, budget, seed, time_limit, (),
+                       cell.spec.criterion.type, speeds)
+    if result.needs_nothing:
+        return result
+    proposals: list[Proposal] = []
+
+    def evaluate(r: Remedy) -> Proposal:
+        proposals.append(_evaluate(len(proposals) + 1, r, base, out, budget, seed, time_limit))
+        return proposals[-1]
+
+    if base.failing:
+        for r in setting_remedies(cell, static):
+            evaluate(r)
+        for whole in (False, True):
+            moves = _moves(cell, static, whole, scratch)
+            for extra in (0.0, *EXTRA):
+                if not moves:
+                    break
+                p = evaluate(moved(cell, moves, whole, extra))
+                if p.failing_after or p.kept:  # more room helps only where check passes and a hazard remains
+                    break
+    elif not speeds:  # check passes and the re-test found a hazard: slowing is the remedy left
+        speeds = move_speeds(cell, budget, seed, scratch)
+        result = replace(result, speeds=speeds)
+    per_move = per_move_remedy(cell, speeds, scratch)
+    if per_move is not None:
+        evaluate(per_move)
+    if scratch.exists():
+        scratch.unlink()
+    return replace(result, candidates=tuple(proposals))
+
+
+def _evaluate(number: int, r: Remedy, base: Checked, out: Path, budget: int, seed: int, time_limit: float) \
+        -> Proposal:
+    path = out / f"candidate-{number}.yaml"
+    try:
+        c = _parse(r, path)
+    except CellstressError as exc:
+        return Proposal(number, r.kind, r.change, r.rows, 0.0, 0.0, r.parts_added, (f"invalid: {exc}",), None,
+                        False, r.text)
+    after, _ = checked(c)
+    test = None if after.failing else retest(c, budget, seed, time_limit)
+    kept = not after.failing and test is not None and test.hazards == 0
+    return Proposal(number, r.kind, r.change, r.rows, _tidy(after.cycle - base.cycle),
+                    _tidy(after.footprint - base.footprint), r.parts_added, after.failing, test, kept, r.text)
+
+
+def _tidy(x: float) -> float:
+    x = round(x, 6)
+    return 0.0 if math.isclose(x, 0.0, abs_tol=1e-9) else x

@@ -1,0 +1,104 @@
+"""``cellstress fix``: a flawed cell (mat-short, its front mat renamed to a hostile name) gets a kept proposal
+whose file passes ``check``; the same command twice gives the same fix.json and proposal bytes; the hostile name
+is escaped in fix.html; the safe baseline needs nothing (exit 0, no proposal); a bad input is one error line.
+
+The module fixture runs fix twice on the same cell (about 20 s each on a quiet machine: the check of the cell
+and of two candidates, and verify at horizon 8 on each candidate, which decides mat-short's in about 1 s); every
+test reads those two runs."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from junit_schema import validate_junit
+
+from cellstress.cell.load import builtin_file
+from cellstress.cli import main
+
+HOSTILE = 'mat<script>alert(1)</script>&"x'
+ARGS = ["--budget", "10", "--seed", "0", "--time-limit", "30"]
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("fix")
+    text = Path(builtin_file("mat-short")).read_text().replace("front-mat", f"'{HOSTILE}'", 1)
+    cell = folder / "cell.yaml"
+    cell.write_text(text)
+    out = []
+    for k in (1, 2):
+        code = main(["fix", str(cell), "--out", str(folder / f"out{k}"), *ARGS, "--junit", str(folder / f"j{k}.xml")])
+        out.append((code, folder / f"out{k}"))
+    return out
+
+
+def test_a_flawed_cell_gets_a_proposal_that_passes_check(runs):
+    code, out = runs[0]
+    assert code == 0
+    doc = json.loads((out / "fix.json").read_text())
+    assert doc["failing_before"] == [HOSTILE, "undetected-reach"]
+    kept = sorted((c for c in doc["candidates"] if c["kept"]), key=lambda c: c["proposal"])
+    assert kept and kept[0]["retest"]["method"] == "verify" and kept[0]["retest"]["proved"]
+    assert kept[0]["floor_added_m2"] <= kept[-1]["floor_added_m2"]  # ranked by cost
+    for c in kept:
+        assert main(["check", str(out / f"proposal-{c['proposal']}.yaml")]) == 0
+    assert not (out / f"proposal-{len(kept) + 1}.yaml").exists()
+
+
+def test_same_inputs_same_bytes(runs):
+    (_, a), (_, b) = runs
+    names = sorted(p.name for p in a.iterdir())
+    assert names == sorted(p.name for p in b.iterdir())
+    assert "fix.json" in names and "fix.html" in names and "proposal-1.yaml" in names
+    for name in names:
+        assert (a / name).read_bytes() == (b / name).read_bytes(), name
+
+
+def test_hostile_name_is_escaped_in_the_page(runs):
+    _, out = runs[0]
+    page = (out / "fix.html").read_text()
+    assert "<script>" not in page and "&lt;script&gt;" in page
+    assert "&amp;&quot;x" in page
+
+
+def test_junit_has_a_passing_verdict(runs):
+    data = (runs[0][1].parent / "j1.xml").read_bytes()
+    root = validate_junit(data)
+    cases = {c.get("name"): c for c in root.iter("testcase")}
+    assert set(cases) == {"fix", "candidate 1: move-device", "candidate 2: move-cell"}
+    assert not list(root.iter("failure")) and b"&lt;script&gt;" in data
+
+
+def test_a_safe_cell_needs_nothing(tmp_path, capsys):
+    assert main(["fix", "baseline", "--out", str(tmp_path), *ARGS]) == 0
+    doc = json.loads((tmp_path / "fix.json").read_text())
+    assert doc["needs_nothing"] and doc["candidates"] == []
+    assert not list(tmp_path.glob("proposal-*.yaml"))
+    assert "NOTHING TO FIX" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("args", [["no-such-cell"], ["baseline", "--time-limit", "0"],
+                                  ["baseline", "--budget", "0"]])
+def test_bad_input_is_one_error_line(args, tmp_path, capsys):
+    assert main(["fix", *args, "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error:")
+
+
+def test_a_row_no_candidate_answers_exits_1(tmp_path, capsys):
+    """The baseline with its bay curtain's lowest beam raised to 0.6 m: only its crawl-under row fails, and no
+    candidate kind answers that row (docs/fix.md): exit 1, no proposal, the JUnit verdict case fails."""
+    text = Path(builtin_file("baseline")).read_text()
+    assert text.count("    bottom: 0.2") == 1
+    cell = tmp_path / "crawl.yaml"
+    cell.write_text(text.replace("    bottom: 0.2", "    bottom: 0.6"))
+    out = tmp_path / "out"
+    assert main(["fix", str(cell), "--out", str(out), *ARGS, "--junit", str(tmp_path / "j.xml")]) == 1
+    doc = json.loads((out / "fix.json").read_text())
+    assert doc["failing_before"] == ["bay-curtain-crawl-under"] and doc["candidates"] == [] and not doc["needs_nothing"]
+    assert not list(out.glob("proposal-*.yaml"))
+    root = validate_junit((tmp_path / "j.xml").read_bytes())
+    assert [c.get("name") for c in root.iter("testcase")] == ["fix"] and len(list(root.iter("failure"))) == 1
+    assert "NO PROPOSAL WORKS" in capsys.readouterr().out
