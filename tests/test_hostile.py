@@ -166,6 +166,11 @@ def _fifo(rel: str) -> Callable[[Path], None]:
     return setup
 
 
+def _no_raw_markup(page: Path) -> None:
+    text = page.read_text(encoding="utf-8")
+    assert "<script>alert" not in text and "&lt;script&gt;" in text and "\x1b" not in text
+
+
 def _link(rel: str, target: str) -> Callable[[Path], None]:
     def setup(folder: Path) -> None:
         (folder / rel).parent.mkdir(parents=True, exist_ok=True)
@@ -737,6 +742,13 @@ OPTIONS: list[Case] = [
       for kind, setup, says in (("link", _link("out/witness-01", "../in"), "is a symbolic link"),
                                 ("file", _write("out/witness-01", b"mine\n"), "is not a folder"),
                                 ("dangling-link", _link("out/witness-01", "../nowhere"), "is a symbolic link"))),
+    # issue 33: fix reads a cell like every command and writes only into --out
+    Case("fix-budget-zero", ("fix", "baseline", "--budget", "0", "--out", "out"), 2, ("budget",)),
+    Case("fix-time-limit-nan", ("fix", "baseline", "--time-limit", "nan", "--out", "out"), 2, ("--time-limit",)),
+    Case("fix-out-is-a-file", ("fix", "baseline", "--out", "in/victim.txt"), 2, ("--out", "not a directory")),
+    Case("fix-markup-name", ("fix", CELL, "--budget", "2", "--time-limit", "5", "--out", "out"), 0,
+         cell=_set("name", "<script>alert(1)</script>"),
+         check=lambda folder, out, err: _no_raw_markup(folder / "out" / "fix.html")),
     # issue 31: verify's checkpoint in --out is an input like any other; its options refuse markup and nonsense
     *(Case(f"verify-checkpoint-{kind}", ("verify", "baseline", "--phases", "cell", "--horizon", "1", "--workers", "1",
                                         "--out", "out"), 2, ("verify-checkpoint.jsonl", says),
