@@ -306,24 +306,17 @@ class _Model:
             self._tree = (cKDTree(np.concatenate(self.feats)), np.concatenate(self.seen))
         tree, seen_at = self._tree
         poses = self.sim.worker_paths(seqs[:, self.lead:]).reshape(-1, L.N_POSE)
+        seen = seen_at[tree.query(self._features(poses))[1]].reshape(n, steps)
         known = np.zeros(n, dtype=np.int64)
         played_brake = np.full((self.n_robots, n), -1)
         played_stop = np.full((self.n_robots, n), -1)
-        played: list[tuple[int, np.ndarray]] = []
         for i, seq in enumerate(map(tuple, seqs.tolist())):
             p = len(seq) - 1
             while p > 0 and seq[:p] not in self.prefixes:
                 p -= 1
             if p:
                 known[i], seen_k, played_brake[:, i], played_stop[:, i] = self.prefixes[seq[:p]]
-                played.append((i, seen_k))
-        # a played prefix's detections are known: only the steps after it ask the nearest played pose
-        ask = (np.arange(steps)[None, :] >= known[:, None]).ravel()
-        seen = np.zeros(n * steps, dtype=seen_at.dtype)
-        seen[ask] = seen_at[tree.query(self._features(poses[ask]))[1]]
-        seen = seen.reshape(n, steps)
-        for i, seen_k in played:
-            seen[i, : known[i]] = seen_k
+                seen[i, : known[i]] = seen_k
         detected = seen.any(axis=1)
         first = (seen > 0).argmax(axis=1)
         mask = seen[np.arange(n), first]
