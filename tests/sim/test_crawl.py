@@ -10,6 +10,7 @@ import yaml
 from cellstress.analysis.iso13855 import check_cell
 from cellstress.analysis.openings import simulated_body_passes_under
 from cellstress.cell.load import builtin_text, parse_cell
+from cellstress.core.iso13857 import WHOLE_BODY_SLOT_MM
 from cellstress.human.body import CRAWL_SPEED, PRONE_HEIGHT, WALK_BLOCK_HEIGHT
 from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
@@ -23,8 +24,8 @@ def _crawl_under(bottom: float | None = None, model: str = "articulated", extra:
     doc = yaml.safe_load(builtin_text("crawl-under"))
     if bottom is not None:
         doc["fences"][0]["bottom"] = bottom
-    doc["human"]["model"] = model
     doc.update(extra or {})
+    doc["human"]["model"] = model
     return Simulator(parse_cell(yaml.safe_dump(doc), "crawl-test.yaml", None))
 
 
@@ -47,7 +48,8 @@ def test_the_prone_body_lies_on_the_floor_no_higher_than_its_declared_height():
 
 
 def test_the_crawler_moves_at_the_crawling_speed_and_a_crouched_worker_still_does_not_walk():
-    sim = _crawl_under(0.0)
+    sim = _crawl_under(0.0, extra={"human": dict(yaml.safe_load(builtin_text("crawl-under"))["human"],
+                                                 start={"xy": [0.0, 3.9], "heading_deg": -90.0})})
     poses, _ = _capsules(sim, ["stand+crawl", "walk+crawl", "walk+crawl"])
     spa = sim.steps_per_action
     step = abs(poses[3 * spa - 1, 1] - poses[2 * spa - 1, 1])
@@ -60,14 +62,14 @@ def test_the_crawler_moves_at_the_crawling_speed_and_a_crouched_worker_still_doe
 def test_the_crawler_passes_under_a_panel_exactly_when_check_says_the_simulated_body_does(bottom):
     """Cross-check of the one declaration (human.body.PRONE_HEIGHT): the kernel's rule (played) and `check`'s
     (analysis.openings) agree on every panel just below and above it; ISO 13857's whole-body rule (180 mm) FAILs
-    every one of these panels in `check`, and names the simulated worker's limit where it cannot pass."""
+    the panels above 180 mm in `check`, which names the simulated worker's limit where it cannot pass."""
     sim = _crawl_under(bottom)
     poses, _ = _capsules(sim, CRAWL)
     passed = poses[-1, 1] < PANEL_Y - 0.2  # the hip (and the footprint) beyond the panel
     assert passed == (bottom > PRONE_HEIGHT) == simulated_body_passes_under(True, bottom)
     sc = check_cell(sim.cell)
     (under,) = [o for o in sc.openings if o.kind == "under"]
-    assert under.admits_body and not under.ok  # ISO 13857: a slot above 180 mm
+    assert under.admits_body == (not under.ok) == (bottom > WHOLE_BODY_SLOT_MM / 1000)  # ISO 13857's whole body
     assert (under.sim_note == "") == passed
     # the paper's worker never gets under it (it walks under panels only from 0.5 m) and check says so
     assert not simulated_body_passes_under(False, bottom) and bottom < WALK_BLOCK_HEIGHT
