@@ -3,6 +3,8 @@ the simulation and `check` share, what sees it, and reaching over a light curtai
 
 from __future__ import annotations
 
+import hashlib
+
 import numpy as np
 import pytest
 import yaml
@@ -13,6 +15,7 @@ from cellstress.cell.load import builtin_text, parse_cell
 from cellstress.core.iso13857 import WHOLE_BODY_SLOT_MM
 from cellstress.human.body import CRAWL_SPEED, PRONE_HEIGHT, WALK_BLOCK_HEIGHT
 from cellstress.sim import layout as L
+from cellstress.sim.kernels.dense import dense_batch
 from cellstress.sim.simulator import Simulator
 
 PANEL_Y = 2.25  # crawl-under's front panel (docs/cells.md)
@@ -118,3 +121,36 @@ def test_an_arm_over_a_curtains_top_is_unseen_and_through_its_beams_is_seen():
     assert rec.body_part.endswith("hand") and rec.human_point[1] < 2.29 - 1.0  # over the top, 1 m past the line
     twin = Simulator("curtain-reach-over-ok").run(witness)
     assert (twin.rows[:, L.M_SEEN].astype(np.int64) & front).any() and not twin.unsafe
+
+
+def test_the_swept_test_misses_no_contact_of_a_crawler_that_fine_samples_find():
+    """The dense 5 ms kernel (kernels.dense) and the swept test play the same crawling motion (move_worker, the
+    tipping to prone included): every episode unsafe at ten samples per step is unsafe with the swept test, no
+    later. Episodes: lie down, crawl under crawl-under's panel (7 actions), then 6 random actions (standing up,
+    reaching...). 200 episodes of 14 actions, about 10 s here: the crawl is rare in uniform episodes."""
+    sim = Simulator("crawl-under")
+    head = [sim.action_index(a) for a in ["stand+crawl"] + ["walk+crawl"] * 7]
+    rng = np.random.default_rng(5)
+    tail = rng.integers(0, sim.n_actions, size=(200, sim.actions_per_episode - len(head)))
+    tail[:100, 0] = sim.action_index("stand+stand-up")  # half of them rise first
+    acts = np.ascontiguousarray(np.hstack([np.tile(head, (200, 1)), tail]).astype(np.int64))
+    swept = sim.run_batch(acts).unsafe_step
+    fine = np.empty(len(acts), dtype=np.int64)
+    dense_batch(sim.params, sim.reset(), acts, 10, fine)
+    hit = fine >= 0
+    assert np.all((swept[hit] >= 0) & (swept[hit] <= fine[hit]))
+    assert hit.sum() > 0  # the check is not vacuous
+
+
+def test_the_paper_worker_plays_bit_for_bit_as_before_crawling():
+    """The paper's worker is untouched by the crawl (its kernels take the branches they took before): the rows of
+    8 fixed episodes and the unsafe steps of 40 on baseline hash as they did on main 1e2b1e6, before this change
+    (measured with that commit's shipped kernels). A later deliberate change of the paper worker's behaviour
+    changes this hash: re-measure it then."""
+    sim = Simulator("baseline")
+    seqs = np.random.default_rng(11).integers(0, sim.n_actions, size=(40, 16))
+    h = hashlib.sha256()
+    for s in seqs[:8]:
+        h.update(sim.run(s.tolist()).rows.tobytes())
+    h.update(np.asarray(sim.run_batch(seqs).unsafe_step).tobytes())
+    assert h.hexdigest() == "a43f304061829a6df41cb9cad50fadc1d8520f47111e63f6e51384718ec3f1c8"
