@@ -6,8 +6,8 @@ Each rule gives one record per device with its arithmetic (``line``) and ``ok``;
 the failed ones ``DEVICE-reach-over``, ``DEVICE-crawl-under``, ``DEVICE-step-over``, ``DEVICE-mounting``,
 ``DEVICE-depth``. Where the standard's way round is one the simulated worker cannot take (no worker steps over
 anything; the paper's worker does not crawl, nor tell reaching over a curtain from reaching through it, the
-articulated one does both), the line
-says so: a search will not find that way in, and the static verdict stands on its own. Sources and the choices made: docs/cells.md, "Ways in".
+articulated one does both), the line says so: a search will not find that way in, and the static verdict stands
+on its own. Sources and the choices made: docs/cells.md, "Ways in".
 """
 
 from __future__ import annotations
