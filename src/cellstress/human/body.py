@@ -4,7 +4,8 @@ Segment proportions are fractions of body height H from Drillis & Contini (1966)
 *Biomechanics and Motor Control of Human Movement* (4th ed., Fig. 4.1): hip (greater trochanter) 0.530 H,
 shoulder 0.818 H, chin 0.870 H, shoulder width 0.259 H, hip width 0.191 H. Radii are round numbers for an
 adult man in work clothes (see docs/cells.md). The trunk pivots at the hip: forward flexion about the body's
-left axis, lateral flexion about its forward axis. Legs stay vertical; arms at rest hang straight down.
+left axis, lateral flexion about its forward axis. Legs stay vertical (but for the articulated worker lying prone:
+kernels.body.pose_body); arms at rest hang straight down.
 """
 
 from __future__ import annotations
