@@ -307,7 +307,8 @@ def test_cli_runner_user_error_is_one_line() -> None:
         "restart-manual, warning-field-short, warning-field-ok, mat-short, mat-ok, palletizing, palletizing-fixed, "
         "door-unlocked, door-locked, muting-long, muting-ok, "
         "two-robots, two-robots-fixed, ssm-latency, ssm-ok, reach-over, reach-over-ok, long-gripper, long-gripper-ok, "
-        "machine-tending, machine-tending-delay, machine-tending-delay-ok)"
+        "machine-tending, machine-tending-delay, machine-tending-delay-ok, crawl-under, crawl-under-ok, "
+        "curtain-reach-over, curtain-reach-over-ok)"
     )
     assert result.stdout == ""
 

@@ -155,8 +155,9 @@ class _Floor:
 class _Spec:
     """As much of a cell as ``device_rules`` reads: devices, no fences, no obstacles, a large floor."""
 
-    def __init__(self, *devices, fences=()):
+    def __init__(self, *devices, fences=(), model="paper"):
         self.devices, self.fences, self.floor = devices, fences, _Floor()
+        self.human = type("_Human", (), {"model": model})()
 
     def solid_obstacles(self):
         return ()
@@ -178,3 +179,14 @@ def test_a_mat_against_a_wall_cannot_be_stepped_across():
     m = E.device_rules(_Spec(mat, fences=(Fence,)))[0]
     # from the open short sides across is 2 m; from the long open side the crossing ends at the fence
     assert m.depth == pytest.approx(2.0) and m.ok
+
+
+def test_the_crawl_under_note_names_only_what_the_simulated_worker_cannot_do():
+    """A curtain whose lowest beam is above 300 mm FAILs for every worker; the paper's worker cannot crawl under it
+    (the row says a search will not find that way), the articulated one can (no note: it lies 0.30 m high)."""
+    paper = E.device_rules(_Spec(_curtain(1.8, 0.4)))[0]
+    crawler = E.device_rules(_Spec(_curtain(1.8, 0.4), model="articulated"))[0]
+    assert not paper.ok and not crawler.ok
+    assert E.CANNOT_CRAWL in paper.line() and "search" not in crawler.line()
+    stepping = E.device_rules(_Spec(_curtain(0.8, 0.2), model="articulated"))[0]
+    assert E.CANNOT_STEP in stepping.line()

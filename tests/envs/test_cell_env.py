@@ -97,7 +97,7 @@ def test_vector_env_equals_single_envs_and_autoresets():
 
 
 def test_the_articulated_worker_as_an_env(tmp_path):
-    """Its 112 actions, and an observation that holds its stance and arm joints."""
+    """Its 119 actions, and an observation that holds its stance and arm joints."""
     text = Path(resources.files("cellstress.cell").joinpath("builtin", "s3-fence-gap.yaml")).read_text()
     cell = tmp_path / "s3-articulated.yaml"
     cell.write_text(text.replace("human:\n", "human:\n  model: articulated\n", 1))
@@ -105,7 +105,7 @@ def test_the_articulated_worker_as_an_env(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(env, skip_render_check=True)
-    assert env.action_space.n == 112 and env.observation_space.shape == (22,)
+    assert env.action_space.n == 119 and env.observation_space.shape == (22,)
     env.reset(seed=0)
     obs, *_ = env.step(env.sim.action_index("stand+reach-up"))
     assert obs[11 + 1] == pytest.approx(np.pi)  # the left shoulder's flexion, after the action

@@ -72,7 +72,7 @@ def test_the_paper_worker_stays_the_default():
 
 def test_actions_are_the_models_own():
     sim = _cell()
-    assert sim.n_actions == 112 and sim.action_names[0] == "walk+upright"
+    assert sim.n_actions == 119 and sim.action_names[0] == "walk+upright"
     assert sim.action_index("stand+reach-over") == sim.action_names.index("stand+reach-over")
     with pytest.raises(ActionError, match="MOVE\\+CHANGE"):
         sim.action_index("turn-left-90+upright")  # a paper action

@@ -44,9 +44,9 @@ def _access_rows(rule) -> list[CheckRow]:
                          f"{_m(rule.behind)} (needs {_m(rule.required)})", text, rule.model_limit)]
     if isinstance(rule, BeamHeights):
         return [CheckRow(f"{rule.device}-crawl-under", "ISO 13855 crawling under", rule.crawl_ok,
-                         f"lowest beam {rule.bottom:.3f} m", text, "" if rule.crawl_ok else rule.model_limit),
+                         f"lowest beam {rule.bottom:.3f} m", text, rule.crawl_limit),
                 CheckRow(f"{rule.device}-step-over", "ISO 13855 stepping over", rule.step_ok,
-                         f"highest beam {rule.top:.3f} m", text, "" if rule.step_ok else rule.model_limit)]
+                         f"highest beam {rule.top:.3f} m", text, rule.step_limit)]
     if isinstance(rule, ScannerMounting):
         return [CheckRow(f"{rule.device}-mounting", "ISO 13855 scanner mounting height", rule.resolution_ok,
                          f"scan plane {rule.height:.3f} m", text),

@@ -4,9 +4,10 @@ mounting height against its resolution, a safety mat too shallow to be stepped a
 
 Each rule gives one record per device with its arithmetic (``line``) and ``ok``; ``StaticCheck.failures`` names
 the failed ones ``DEVICE-reach-over``, ``DEVICE-crawl-under``, ``DEVICE-step-over``, ``DEVICE-mounting``,
-``DEVICE-depth``. Where the standard's way round is one the simulated worker cannot take (it neither crawls nor
-steps over anything, and its arm treats a curtain as a wall), the line says so: a search will not find that way
-in, and the static verdict stands on its own. Sources and the choices made: docs/cells.md, "Ways in".
+``DEVICE-depth``. Where the standard's way round is one the simulated worker cannot take (no worker steps over
+anything; the paper's worker does not crawl, nor tell reaching over a curtain from reaching through it, the
+articulated one does both), the line says so: a search will not find that way in, and the static verdict stands
+on its own. Sources and the choices made: docs/cells.md, "Ways in".
 """
 
 from __future__ import annotations
@@ -26,7 +27,12 @@ from cellstress.devices.safety_mat import SafetyMat
 from cellstress.human.body import WALK_BLOCK_HEIGHT
 
 CANNOT_CRAWL = "the simulated worker cannot crawl or step over: a search will not find this way in"
-CANNOT_REACH_OVER = "the simulated worker's arm treats a curtain as a wall: a search will not find this way in"
+CANNOT_STEP = "the simulated worker cannot step over: a search will not find this way in"
+# The paper's worker neither crawls nor leans over a curtain; the articulated one crawls prone (its body 0.30 m
+# high: human.body.PRONE_HEIGHT, so a beam or scan plane above that misses it) and reaches over a curtain's top
+# with its arms (a curtain is a sensor, not a wall: an arm above the top beam is not seen). docs/worker.md.
+CANNOT_REACH_OVER = ("the paper's worker's arms are reach volumes no device sees, over the top or through the field "
+                     "alike: the articulated worker's search looks for this way in")
 _TOL = 1e-9
 
 
@@ -61,6 +67,7 @@ class CurtainReachOver:
     robot: str = ""
     robot_part: str = ""
     t: float = math.nan  # s, episode time of that pose (mod the cycle)
+    sim_note: str = CANNOT_REACH_OVER  # what the simulated worker cannot do here ("": the articulated worker can)
 
     @property
     def required(self) -> float:
@@ -74,15 +81,15 @@ class CurtainReachOver:
     @property
     def model_limit(self) -> str:
         """What the simulated worker cannot do to take this way in ('' where the row passes)."""
-        return "" if self.ok else CANNOT_REACH_OVER
+        return "" if self.ok else self.sim_note
 
     def line(self) -> str:
         lo, hi = self.band
         b = self.top * 1000.0
         if math.isinf(self.c_ro):
             return (f"{self.device}: reach over its top (ISO 13855 6.5, Table 1): upper edge b = {mm(b)} mm is below "
-                    f"the table's first column ({mm(I.C_RO_B_MM[0])} mm): no distance is enough: FAIL; "
-                    + self.model_limit)
+                    f"the table's first column ({mm(I.C_RO_B_MM[0])} mm): no distance is enough: FAIL"
+                    + (f"; {self.model_limit}" if self.model_limit else ""))
         band = f"a {lo * 1000:.0f}..{hi * 1000:.0f} mm" if math.isfinite(hi) else f"a >= {lo * 1000:.0f} mm"
         text = (f"{self.device}: reach over its top (ISO 13855 6.5, Table 1): b = {mm(b)} mm, hazard at "
                 f"{self.hazard_height:.2f} m ({band}): C_RO = {mm(self.c_ro)} mm, S_RO = {mm(self.K)}*{self.T:.2f} + "
@@ -91,7 +98,7 @@ class CurtainReachOver:
                 f"{mm(self.required * 1000)}) = {mm(max(self.through, self.required) * 1000)} mm")
         if self.robot_part:
             text += f" ({self.robot_part} at t = {self.t:.2f} s)"
-        return text if self.ok else text + "; " + self.model_limit
+        return text + "; " + self.model_limit if self.model_limit else text
 
 
 def _c_ro_bands(top: float) -> list[tuple[float, float, float]]:
@@ -106,13 +113,14 @@ def _c_ro_bands(top: float) -> list[tuple[float, float, float]]:
 
 
 def curtain_reach_over(device: LightCurtain, vol: HazardVolume, T: float, through: float,
-                       robot: str = "") -> CurtainReachOver:
+                       robot: str = "", articulated: bool = False) -> CurtainReachOver:
     """Table 1 at a light curtain: over every row band, the horizontal distance from the curtain's line to the
     zone's part in the band against K T + C_RO; the band with the least margin (the lowest on a tie). The zone
     counts on both sides of the line (the check does not decide which side the hazard is on)."""
     p0, p1 = device.start, device.end
     d = point_segment(vol.c[:, 0], vol.c[:, 1], p0[0], p0[1], p1[0], p1[1])[0]
     z, rad = vol.c[:, 2], vol.r
+    note = "" if articulated else CANNOT_REACH_OVER
     best: CurtainReachOver | None = None
     for lo, hi, c in _c_ro_bands(float(device.top)):
         gap = np.maximum(np.maximum(lo - z, z - hi), 0.0)  # vertical distance of each ball's centre from the band
@@ -124,12 +132,12 @@ def curtain_reach_over(device: LightCurtain, vol: HazardVolume, T: float, throug
         i = int(np.flatnonzero(cut)[k])
         row = CurtainReachOver(device.name, float(device.top), T, I.K_REACH_OVER, c, (max(lo, 0.0), hi),
                                float(min(max(vol.c[i, 2], lo, 0.0), hi)), max(float(dist[k]), 0.0), through, robot,
-                               vol.part_names[int(vol.part[i])], round(float(vol.t[i]), 3))
+                               vol.part_names[int(vol.part[i])], round(float(vol.t[i]), 3), note)
         if best is None or row.behind - row.required < best.behind - best.required - 1e-12:
             best = row
     if best is None:  # (no zone at all)
         return CurtainReachOver(device.name, float(device.top), T, I.K_REACH_OVER, 0.0, (0.0, math.inf), math.nan,
-                                math.inf, through, robot)
+                                math.inf, through, robot, sim_note=note)
     return best
 
 
@@ -142,6 +150,7 @@ class BeamHeights:
     device: str
     bottom: float  # m
     top: float  # m
+    articulated: bool = False  # the cell's worker crawls (under a lowest beam above PRONE_HEIGHT)
 
     @property
     def crawl_ok(self) -> bool:
@@ -156,16 +165,28 @@ class BeamHeights:
         return self.crawl_ok and self.step_ok
 
     @property
+    def crawl_limit(self) -> str:
+        """What the simulated worker cannot do to crawl under the lowest beam ('' where it can, or need not)."""
+        return "" if self.crawl_ok or self.articulated else CANNOT_CRAWL
+
+    @property
+    def step_limit(self) -> str:
+        """What the simulated worker cannot do to step over the highest beam ('' where it need not)."""
+        return "" if self.step_ok else CANNOT_STEP if self.articulated else CANNOT_CRAWL
+
+    @property
     def model_limit(self) -> str:
-        """What the simulated worker cannot do to take this way in ('' where the row passes)."""
-        return "" if self.ok else CANNOT_CRAWL
+        """The note the row's line carries ('' where the row passes or the worker can take every way in)."""
+        if self.ok:
+            return ""
+        return self.step_limit if self.articulated else CANNOT_CRAWL
 
     def line(self) -> str:
         lo, hi = self.bottom * 1000.0, self.top * 1000.0
         text = (f"{self.device}: lowest beam {mm(lo)} mm <= {mm(I.CRAWL_UNDER_MAX_MM)} mm (crawling under)? "
                 f"{'ok' if self.crawl_ok else 'FAIL'}; highest beam {mm(hi)} mm >= {mm(I.STEP_OVER_MIN_MM)} mm "
                 f"(stepping over)? {'ok' if self.step_ok else 'FAIL'} (ISO 13855 6.2, whole-body detection)")
-        return text if self.ok else text + "; " + self.model_limit
+        return text + "; " + self.model_limit if self.model_limit else text
 
 
 @dataclass(frozen=True)
@@ -176,6 +197,7 @@ class ScannerMounting:
     device: str
     height: float  # m, H
     resolution: float  # mm, d
+    articulated: bool = False  # the cell's worker crawls (under a scan plane above PRONE_HEIGHT)
 
     @property
     def min_height_mm(self) -> float:
@@ -200,8 +222,9 @@ class ScannerMounting:
 
     @property
     def model_limit(self) -> str:
-        """What the simulated worker cannot do to take this way in: crawl under the plane ('' where it need not)."""
-        return "" if self.crawl_ok else CANNOT_CRAWL
+        """What the simulated worker cannot do to take this way in: crawl under the plane ('' where it need not,
+        or can: the articulated worker crawls)."""
+        return "" if self.crawl_ok or self.articulated else CANNOT_CRAWL
 
     def line(self) -> str:
         h, d = self.height * 1000.0, self.resolution
@@ -296,12 +319,13 @@ def device_rules(spec) -> tuple:
     """The rules that need no hazard zone: every curtain's beam heights, every scanner's mounting, every mat's
     depth, in the order of the cell's devices."""
     covers = entry_covers(spec)
+    articulated = spec.human.model == "articulated"
     out: list = []
     for d in spec.devices:
         if isinstance(d, LightCurtain):
-            out.append(BeamHeights(d.name, float(d.bottom), float(d.top)))
+            out.append(BeamHeights(d.name, float(d.bottom), float(d.top), articulated))
         elif isinstance(d, LaserScanner):
-            out.append(ScannerMounting(d.name, float(d.height), float(d.resolution_mm)))
+            out.append(ScannerMounting(d.name, float(d.height), float(d.resolution_mm), articulated))
         elif isinstance(d, SafetyMat):
             out.append(mat_depth(d, covers))
     return tuple(out)

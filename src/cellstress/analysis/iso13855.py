@@ -432,7 +432,8 @@ def _access_rules(spec, layout, devices, vol: HazardVolume) -> tuple:
             continue
         if row.robot and row.robot not in vols:
             vols[row.robot] = hazard_volume(layout, robot=names.index(row.robot))
-        out.append(curtain_reach_over(dev, vols.get(row.robot, vol), row.T, row.required, row.robot))
+        out.append(curtain_reach_over(dev, vols.get(row.robot, vol), row.T, row.required, row.robot,
+                                      spec.human.model == "articulated"))
     return tuple(out) + device_rules(spec)
 
 

@@ -37,7 +37,7 @@ from cellstress.analysis.floor_fill import FloorFill
 from cellstress.analysis.plane import point_segment, points_in_polygon
 from cellstress.core.iso13857 import WHOLE_BODY_SLOT_MM, WHOLE_BODY_SQUARE_ROUND_MM
 from cellstress.core.records import DoorLeaf, ScanPlane
-from cellstress.human.body import WALK_BLOCK_HEIGHT
+from cellstress.human.body import PRONE_HEIGHT, WALK_BLOCK_HEIGHT
 
 PROBE = 0.25  # m either side of an opening's line (beyond the detection margins and a grid cell)
 ON_TOL = 0.05  # m, an opening within this of a detection primitive lies on it
@@ -248,6 +248,24 @@ def _covering(spec, a, b, inside, fill: FloorFill) -> tuple[str, ...]:
     return tuple(out)
 
 
+def simulated_body_passes_under(articulated: bool, bottom: float) -> bool:
+    """Whether the simulated worker gets under a panel whose bottom edge is ``bottom`` [m] above the floor: walking
+    from WALK_BLOCK_HEIGHT; the articulated worker also crawling, above its prone body's height PRONE_HEIGHT (the
+    declaration kernels.sensing.panel_stops_body reads: the same comparisons)."""
+    return not bottom < WALK_BLOCK_HEIGHT or (articulated and not bottom <= PRONE_HEIGHT)
+
+
+def crawl_note(articulated: bool, bottom: float) -> str:
+    """What an opening under a panel raised ``bottom`` [m] says about the simulated worker ("": it passes)."""
+    if simulated_body_passes_under(articulated, bottom):
+        return ""
+    if articulated:
+        return (f"the simulated worker crawls under a panel only above {PRONE_HEIGHT:.2f} m, its prone body's "
+                "height: a search will not find this way in")
+    return (f"the paper's worker cannot crawl (it walks under a panel only from {WALK_BLOCK_HEIGHT:.1f} m; "
+            f"the articulated worker crawls under one above {PRONE_HEIGHT:.2f} m): a search will not find this way in")
+
+
 def perimeter_openings(spec, fill: FloorFill, body_radius: float) -> tuple[Opening, ...]:
     """The openings of ``candidate_openings`` that lead from the start's unseen region to floor outside it."""
     out = []
@@ -268,9 +286,7 @@ def perimeter_openings(spec, fill: FloorFill, body_radius: float) -> tuple[Openi
         out_pts, in_pts = pair
         covered = _covering(spec, a, b, in_pts, fill)
         if kind == "under":
-            note = ("the simulated worker cannot crawl (it walks under a panel only from "
-                    f"{WALK_BLOCK_HEIGHT:.1f} m): a search will not find this way in") \
-                if top < WALK_BLOCK_HEIGHT else ""
+            note = crawl_note(spec.human.model == "articulated", top)
         else:
             note = (f"the simulated worker (body radius {body_radius:.2f} m) needs {2 * body_radius:.2f} m: a search "
                     "will not find this way in") if width < 2 * body_radius else ""

@@ -38,7 +38,8 @@ BUILTIN_CELLS: tuple[str, ...] = ("baseline", "s1-scanner-width", "s2-elbow-intr
                                   "door-unlocked", "door-locked", "muting-long", "muting-ok",
                                   "two-robots", "two-robots-fixed", "ssm-latency", "ssm-ok", "reach-over",
                                   "reach-over-ok", "long-gripper", "long-gripper-ok", "machine-tending",
-                                  "machine-tending-delay", "machine-tending-delay-ok")
+                                  "machine-tending-delay", "machine-tending-delay-ok", "crawl-under", "crawl-under-ok",
+                                  "curtain-reach-over", "curtain-reach-over-ok")
 
 
 @dataclass(frozen=True)

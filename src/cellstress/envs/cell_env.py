@@ -1,7 +1,7 @@
 """A cell as a Gymnasium env: the paper's worker acts, the cell's criterion rewards, the unsafe set terminates.
 
 * **Action**: ``Discrete(n)``, the worker model's actions (``Simulator.action_names``: the paper's 30 ``WALK+BODY``,
-  the articulated worker's 112 ``MOVE+CHANGE``; one action is 0.2 s).
+  the articulated worker's 119 ``MOVE+CHANGE``; one action is 0.2 s).
 * **Observation** (float64, 11 values): time [s], x, y [m], cos and sin of the heading, forward and lateral
   flexion [rad], the robot's stop phase (0 running, 1 stop requested, 2 braking, 3 stopped), d_HR [m], v_R
   [m/s] and the robot's path time [s], all at the action's last 50 ms step; for the articulated worker 11 more:

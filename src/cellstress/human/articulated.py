@@ -33,6 +33,7 @@ from cellstress.human.actions import (
     index_in,
 )
 from cellstress.human.anthropometry import GAITS, POSTURES
+from cellstress.human.body import PRONE_HIP_Z
 from cellstress.human.reach import JOINT_RANGES_DEG
 
 # Feet: (speed as a fraction of walking speed, direction relative to the heading [deg], turn [deg]).
@@ -57,14 +58,18 @@ TRUNK: dict[str, tuple[float, float]] = {
     "bend-right": (0.0, -1.0),
 }
 
-# Stances (human.anthropometry.POSTURES): the hip's height above its standing height.
-STANCES = ("stand-up", "crouch", "kneel", "tiptoe")
+# Stances (human.anthropometry.POSTURES): the hip's height above its standing height. "crawl" lies prone, the hip
+# at human.body.PRONE_HIP_Z: the worker crawls at CRAWL_SPEED and passes under panels higher than PRONE_HEIGHT.
+STANCES = ("stand-up", "crouch", "kneel", "tiptoe", "crawl")
 
 
 def stance_drop(stance: str, stature: float) -> float:
     """The hip's height in ``stance`` above its standing height [m] for a body of ``stature`` [m]."""
+    stand = POSTURES["stand"].hip_height(stature)
+    if stance == "crawl":
+        return PRONE_HIP_Z - stand
     posture = POSTURES["stand" if stance == "stand-up" else stance]
-    return posture.hip_height(stature) - POSTURES["stand"].hip_height(stature)
+    return posture.hip_height(stature) - stand
 
 # Arm targets [deg] in human.reach's joint order (flexion, abduction, rotation, elbow, wrist); "hang" lets the
 # arms hang plumb whatever the trunk does.
@@ -80,7 +85,9 @@ ARMS: dict[str, tuple[float, float, float, float, float]] = {
 }
 
 CHANGES: tuple[str, ...] = (*TRUNK, *STANCES, *ARMS)
-ACTION_NAMES: tuple[str, ...] = tuple(f"{m}+{c}" for m in MOVES for c in CHANGES)
+# The 112 actions the worker had before it could crawl keep their indices; the seven MOVE+crawl follow.
+ACTION_NAMES: tuple[str, ...] = (*(f"{m}+{c}" for m in MOVES for c in CHANGES if c != "crawl"),
+                                 *(f"{m}+crawl" for m in MOVES))
 _GRAMMAR = f"the articulated worker's actions are MOVE+CHANGE with MOVE in {', '.join(MOVES)} and CHANGE in " \
            f"{', '.join(CHANGES)}"
 
@@ -95,6 +102,7 @@ _CHANGE_WORDS = {"upright": ("straightens up", "straightening up"),
                  "bend-right": ("bends to the right", "bending right"),
                  "stand-up": ("rises from a crouch", "rising"), "crouch": ("crouches", "crouching"),
                  "kneel": ("kneels", "kneeling"), "tiptoe": ("rises on tiptoe", "on tiptoe"),
+                 "crawl": ("lies down to crawl", "crawling"),
                  "hang": ("lets the arms hang", "arms down"), "reach-low": ("reaches forward and down", "reaching low"),
                  "reach-forward": ("reaches forward", "reaching forward"),
                  "reach-high": ("reaches forward and up", "reaching high"), "reach-up": ("reaches up", "reaching up"),

@@ -4,7 +4,8 @@ Segment proportions are fractions of body height H from Drillis & Contini (1966)
 *Biomechanics and Motor Control of Human Movement* (4th ed., Fig. 4.1): hip (greater trochanter) 0.530 H,
 shoulder 0.818 H, chin 0.870 H, shoulder width 0.259 H, hip width 0.191 H. Radii are round numbers for an
 adult man in work clothes (see docs/cells.md). The trunk pivots at the hip: forward flexion about the body's
-left axis, lateral flexion about its forward axis. Legs stay vertical; arms at rest hang straight down.
+left axis, lateral flexion about its forward axis. Legs stay vertical (but for the articulated worker lying prone:
+kernels.body.pose_body); arms at rest hang straight down.
 """
 
 from __future__ import annotations
@@ -38,6 +39,18 @@ MODEL_PAPER, MODEL_ARTICULATED = 0.0, 1.0  # BODY_PARAMS' MODEL: how the kernels
 NO_WALK_BELOW = -0.15  # m: with the hip this far below standing (crouching, kneeling) the worker does not walk
 BODY_RADIUS = 0.20  # m, the footprint that keeps the body centre from fences and table edges
 WALK_BLOCK_HEIGHT = 0.5  # m: a fence panel whose bottom is above this does not stop walking (the worker ducks)
+R_TRUNK = 0.15  # m, the trunk capsule's radius
+# The crawling (prone) body of the articulated worker: lying on the floor, its trunk capsule's axis at R_TRUNK, so
+# the body is 2 R_TRUNK = 0.30 m high: ISO 13855's 300 mm (core.iso13855.CRAWL_UNDER_MAX_MM), the plane height at
+# which the standard counts on a crawling person being detected. PRONE_HEIGHT is THE rule for passing under a
+# panel prone (kernels.sensing.panel_stops_body) and the height `check` names (analysis.openings); docs/worker.md.
+PRONE_HIP_Z = R_TRUNK  # m: the hip (the trunk's pivot) when prone
+PRONE_HEIGHT = 2.0 * R_TRUNK  # m: the prone body's top; it passes under a panel whose bottom is above this
+PRONE_BEGIN_Z = 0.22  # m: from this hip height down the body tips forward to prone (below every crouch, 0.167 H)
+PRONE_TOL = 1e-9  # m: a hip this close to PRONE_HIP_Z is prone (the stance's drop is computed in floating point)
+# Crawling speed [m/s]: low crawling (body on the floor), 0.77 m/s, the mean of 24 young adults over up to 91 m
+# (Cao, Davis, Gallagher, Schall, Sesek, Safety Science 104:1-9, 2018); never faster than the cell's walking speed.
+CRAWL_SPEED = 0.77
 
 # The body parameter vector the compiled simulator poses the worker from (``BodyDimensions.params``).
 BODY_PARAMS = VectorSpec("body parameters", (
@@ -105,7 +118,7 @@ class BodyDimensions:
         p[B_HEAD_RISE] = (0.935 - 0.530) * h  # head centre between chin (0.870 H) and vertex (1.0 H)
         p[B_TRUNK_TOP] = (0.818 - 0.530) * h - 0.03
         p[B_R_LEG] = 0.07
-        p[B_R_TRUNK] = 0.15
+        p[B_R_TRUNK] = R_TRUNK
         p[B_R_HEAD] = 0.10
         p[B_R_ARM] = 0.05
         p[B_ARM_LEN] = self.arm_length

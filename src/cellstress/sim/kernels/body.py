@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from cellstress.core.jit import njit
+from cellstress.human.body import PRONE_BEGIN_Z, PRONE_HIP_Z, PRONE_TOL
 from cellstress.sim.layout import (
     B_ARM_LEN,
     B_FOREARM,
@@ -27,6 +28,11 @@ from cellstress.sim.layout import (
     B_UPPER_ARM,
     POSE_EXT,
 )
+
+# How far a point of the worker can move per unit change of prone_fraction, in units of the worker's radius
+# (C_RHO): the trunk's effective forward flexion by pi/2 and its lateral flexion by at most pi/2 (the limit), the
+# legs' angle by pi/2, and their length by at most the worker's radius (kernels.sweep: _worker_travel).
+PRONE_TRAVEL = 1.5 * np.pi + 1.0
 
 REACH_SLACK = 2.0  # reach-field grid spacings added to the worker's radius (the field is interpolated)
 
@@ -66,9 +72,35 @@ def pose_capsules(P, poses, W, A, B, R):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def prone_fraction(hip_z):
+    """How far the articulated worker's body has tipped forward towards lying prone (0: not at all, 1: prone)
+    for its hip at ``hip_z`` [m]: 0 from PRONE_BEGIN_Z up, 1 at PRONE_HIP_Z (to PRONE_TOL), linear between, so
+    every point moves continuously as the stance changes (the swept test's bound relies on it)."""
+    if hip_z >= PRONE_BEGIN_Z:
+        return 0.0
+    if hip_z <= PRONE_HIP_Z + PRONE_TOL:
+        return 1.0
+    return (PRONE_BEGIN_Z - hip_z) / (PRONE_BEGIN_Z - PRONE_HIP_Z)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def pose_body(b, x, y, heading, fwd, lat, ext, e0, ha, hb, hr, sh, tr):
     """human_pose on the arrays themselves (the hot path: see the module docstring). ``ext[e0]`` is the hip's
-    drop and ``ext[e0 + 1 + 5 k + j]`` arm k's joint j; the paper's worker (BODY_PARAMS MODEL 0) reads neither."""
+    drop and ``ext[e0 + 1 + 5 k + j]`` arm k's joint j; the paper's worker (BODY_PARAMS MODEL 0) reads neither.
+
+    The articulated worker with its hip below PRONE_BEGIN_Z tips forward (``prone_fraction`` s): the trunk's
+    flexion goes to 90 degrees and its lateral flexion to 0 by s, the legs turn backwards about the hip by s 90
+    degrees and stretch to their standing length; prone (s = 1) the trunk and head lie along the floor at the
+    hip's height PRONE_HIP_Z = R_TRUNK, the legs behind, the arms posed from the shoulders as ever."""
+    articulated = b[B_MODEL] != 0.0
+    hz = b[B_HIP_Z]
+    s = 0.0
+    if articulated:
+        hz += ext[e0]
+        s = prone_fraction(hz)
+        if s > 0.0:
+            fwd = fwd + s * (0.5 * np.pi - fwd)
+            lat = lat * (1.0 - s)
     ch, shh = np.cos(heading), np.sin(heading)
     cf, sf = np.cos(fwd), np.sin(fwd)
     cl, sl = np.cos(lat), np.sin(lat)
@@ -79,10 +111,6 @@ def pose_body(b, x, y, heading, fwd, lat, ext, e0, ha, hb, hr, sh, tr):
     tr[0, 0], tr[1, 0], tr[2, 0] = xb0 * ch - xb1 * shh, xb0 * shh + xb1 * ch, xb2
     tr[0, 1], tr[1, 1], tr[2, 1] = yb0 * ch - yb1 * shh, yb0 * shh + yb1 * ch, yb2
     tr[0, 2], tr[1, 2], tr[2, 2] = zb0 * ch - zb1 * shh, zb0 * shh + zb1 * ch, zb2
-    articulated = b[B_MODEL] != 0.0
-    hz = b[B_HIP_Z]
-    if articulated:
-        hz += ext[e0]
     lx, ly = -shh, ch  # body left in the world
     # legs
     for k in range(2):
@@ -90,6 +118,12 @@ def pose_body(b, x, y, heading, fwd, lat, ext, e0, ha, hb, hr, sh, tr):
         ha[k, 0], ha[k, 1], ha[k, 2] = x + sgn * b[B_LEG_HALF] * lx, y + sgn * b[B_LEG_HALF] * ly, hz
         hb[k, 0], hb[k, 1], hb[k, 2] = ha[k, 0], ha[k, 1], b[B_R_LEG]
         hr[k] = b[B_R_LEG]
+        if s > 0.0:  # tipping forward: the leg turns back about the hip, not below the floor
+            th = 0.5 * np.pi * s
+            length = (hz - b[B_R_LEG]) * (1.0 - s) + (b[B_HIP_Z] - b[B_R_LEG]) * s
+            back = length * np.sin(th)
+            hb[k, 0], hb[k, 1] = ha[k, 0] - back * ch, ha[k, 1] - back * shh
+            hb[k, 2] = max(hz - length * np.cos(th), b[B_R_LEG])
     # trunk and head
     ha[2, 0], ha[2, 1], ha[2, 2] = x, y, hz
     for r in range(3):

@@ -6,18 +6,21 @@ from __future__ import annotations
 import numpy as np
 
 from cellstress.core.jit import njit
-from cellstress.human.body import WALK_BLOCK_HEIGHT
+from cellstress.human.body import PRONE_HEIGHT, WALK_BLOCK_HEIGHT
 from cellstress.sim.geometry import (
     NO_REFCOUNT,
     capsule_touches_prism,
+    point_in_polygon,
     point_segment_2d,
     polygon_distance,
     segment_rectangle_xyz,
+    segment_segment_xyz,
 )
-from cellstress.sim.kernels.body import pose_body
+from cellstress.sim.kernels.body import pose_body, prone_fraction
 from cellstress.sim.layout import (
     B_ARM_LEN,
     B_HEAD_RISE,
+    B_HIP_Z,
     B_MODEL,
     B_N_CAPS,
     B_R_HEAD,
@@ -50,6 +53,10 @@ def device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
             lo, hi = min(a2, b2), max(a2, b2)
             if H < lo - r or H > hi + r:
                 continue
+            if body[B_MODEL] != 0.0:  # the articulated worker: the whole capsule (a crawler lies along the plane)
+                if capsule_meets_plane_region(a0, a1, a2, b0, b1, b2, r, H, dev_verts, start, count):
+                    return True
+                continue
             if b2 == a2:
                 t = 0.0
             else:
@@ -78,16 +85,57 @@ def device_sees(dev_kind, dev_rect, dev_poly, dev_verts, body, d, ha, hb, hr):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def feet_ok(r, fl, obs_verts, obs_poly, fences, x, y):
+def capsule_meets_plane_region(a0, a1, a2, b0, b1, b2, r, H, verts, start, count):
+    """The capsule (axis a-b, radius r) reaches the polygon (verts[start:start + count]) lying in the plane z = H:
+    the axis's distance to that region is at most r. It is attained where the axis crosses the plane over the
+    polygon, at an end of the axis over or beside the polygon, or against one of its edges."""
+    if a2 != b2 and (a2 - H) * (b2 - H) <= 0.0:
+        t = (H - a2) / (b2 - a2)
+        if point_in_polygon(a0 + t * (b0 - a0), a1 + t * (b1 - a1), verts, start, count):
+            return True
+    r2 = r * r
+    for e in range(2):
+        px, py, pz = (a0, a1, a2) if e == 0 else (b0, b1, b2)
+        dp = polygon_distance(px, py, verts, start, count)
+        if dp * dp + (pz - H) * (pz - H) <= r2:
+            return True
+    for i in range(count):
+        j = start + i
+        k = start + (i + 1) % count
+        if segment_segment_xyz(a0, a1, a2, b0, b1, b2, verts[j, 0], verts[j, 1], H, verts[k, 0], verts[k, 1],
+                               H)[0] <= r2:
+            return True
+    return False
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def panel_stops_body(bottom, prone):
+    """Whether a fence panel (or door leaf) whose bottom edge is ``bottom`` [m] above the floor stops the worker's
+    body passing under it: walking, below WALK_BLOCK_HEIGHT (above it the worker ducks); prone (the articulated
+    worker's crawl), unless the gap is higher than the prone body, PRONE_HEIGHT (human.body). The one rule every
+    kernel applies (through feet_ok), and the height analysis.openings names."""
+    if prone:
+        return bottom <= PRONE_HEIGHT
+    return bottom < WALK_BLOCK_HEIGHT
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def is_prone(body, drop):
+    """The articulated worker lies prone (crawls) with its hip ``drop`` below standing (``prone_fraction`` 1)."""
+    return body[B_MODEL] != 0.0 and prone_fraction(body[B_HIP_Z] + drop) >= 1.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def feet_ok(r, fl, obs_verts, obs_poly, fences, x, y, prone):
     """The footprint circle (radius r) stays on the floor, off every obstacle (the table's among them: the worker
-    never climbs onto one, however low) and clear of fence panels."""
+    never climbs onto one, however low) and clear of the fence panels that stop it (``panel_stops_body``)."""
     if x - r < fl[0] or x + r > fl[1] or y - r < fl[2] or y + r > fl[3]:
         return False
     for t in range(obs_poly.shape[0]):
         if polygon_distance(x, y, obs_verts, obs_poly[t, 0], obs_poly[t, 1]) < r:
             return False
     for f in range(fences.shape[0]):
-        if fences[f, 4] < WALK_BLOCK_HEIGHT and \
+        if panel_stops_body(fences[f, 4], prone) and \
                 point_segment_2d(x, y, fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3]) < r:
             return False
     return True
@@ -173,6 +221,9 @@ def path_blocked(body, fences, obs_verts, obs_poly, obs_box, state, x1, y1, h1, 
     big = max(abs(h1 - h0), abs(f1 - f0), abs(l1 - l0))
     for i in range(1, 11):
         big = max(big, abs(ext1[i] - state[S_DROP + i]))
+    # tipping towards prone turns the trunk and legs (pose_body) by up to pi times the change of prone_fraction
+    hip = body[B_HIP_Z]
+    big = max(big, np.pi * abs(prone_fraction(hip + ext1[0]) - prone_fraction(hip + state[S_DROP])))
     # (moving the feet or the hip alone moves every point on a straight line, which the paths below follow
     # exactly: only turning needs poses in between)
     n = max(1, int(np.ceil(big / SWEEP_ANGLE)))

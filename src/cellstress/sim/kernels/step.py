@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from cellstress.core.jit import njit
+from cellstress.human.body import CRAWL_SPEED
 from cellstress.sim.geometry import NO_REFCOUNT, segment_segment_xyz
 from cellstress.sim.kernels.body import pose_body
 from cellstress.sim.kernels.doors import door_signals, muted, note_push, place_doors, push_doors, unlock_doors
@@ -18,7 +19,7 @@ from cellstress.sim.kernels.fences import collect_near_fences
 from cellstress.sim.kernels.reach import reach_value_at
 from cellstress.sim.kernels.robot import live_path_time, other_robots, robot_at
 from cellstress.sim.kernels.scaling import command, commands_due
-from cellstress.sim.kernels.sensing import body_blocked, device_sees, feet_ok, path_blocked
+from cellstress.sim.kernels.sensing import body_blocked, device_sees, feet_ok, is_prone, path_blocked
 from cellstress.sim.kernels.separation import separation
 from cellstress.sim.kernels.sweep import sweep_step
 from cellstress.sim.layout import (
@@ -353,13 +354,15 @@ def move_worker(P, state, action, h0, f0, l0, frac, W):
     ext = W.ext1
     if articulated:
         blend_limbs(act, action, W.ext0, state, f, 1.0 / P.spa, ext)
-        if state[S_DROP] < NO_WALK_BELOW:
-            walks = 0.0  # crouched or kneeling: the feet stay
+    prone = articulated and is_prone(body, state[S_DROP])
+    speed = min(CRAWL_SPEED, body[B_WALK_SPEED]) if prone else body[B_WALK_SPEED]
+    if articulated and state[S_DROP] < NO_WALK_BELOW and not prone:
+        walks = 0.0  # crouched or kneeling: the feet stay (prone, the worker crawls)
     nx, ny = x, y
     if walks != 0.0:
-        stride = body[B_WALK_SPEED] * P.scal[C_DT] * walks
+        stride = speed * P.scal[C_DT] * walks
         nx, ny = x + stride * np.cos(h + act[action, A_DIR]), y + stride * np.sin(h + act[action, A_DIR])
-        if not feet_ok(body[B_BODY_RADIUS], floor, obs_verts, obs_poly, fences, nx, ny):
+        if not feet_ok(body[B_BODY_RADIUS], floor, obs_verts, obs_poly, fences, nx, ny, prone):
             # walking into a closed door pushes it (at the time of the step being taken)
             push_doors(P, state, body[B_BODY_RADIUS], nx, ny, t + P.scal[C_DT])
             nx, ny = x, y

@@ -30,8 +30,9 @@ from __future__ import annotations
 import numpy as np
 
 from cellstress.core.jit import njit
+from cellstress.human.body import PRONE_BEGIN_Z
 from cellstress.sim.geometry import NO_REFCOUNT, segment_segment_xyz
-from cellstress.sim.kernels.body import pose_body
+from cellstress.sim.kernels.body import PRONE_TRAVEL, pose_body, prone_fraction
 from cellstress.sim.kernels.fences import blocking_panel, collect_near_fences, fence_detour_bound
 from cellstress.sim.kernels.params import SWEEP_CERTIFIED, SWEEP_DEPTH
 from cellstress.sim.kernels.reach import TRACE_REL_TOL, reach_field_at
@@ -45,6 +46,7 @@ from cellstress.sim.layout import (
     A_Q0,
     A_TURN,
     B_ARM_LEN,
+    B_HIP_Z,
     B_MODEL,
     B_N_CAPS,
     B_WALK_SPEED,
@@ -187,6 +189,9 @@ def _worker_travel(P, prev, state):
     out = np.sqrt(dx * dx + dy * dy) + P.scal[C_RHO] * turn
     if b[B_MODEL] != 0.0:
         out += abs(state[S_DROP] - prev[S_DROP])
+        # tipping towards prone (body.pose_body): prone_fraction is monotone in the drop, which moves linearly
+        out += P.scal[C_RHO] * PRONE_TRAVEL * abs(prone_fraction(b[B_HIP_Z] + state[S_DROP]) -
+                                                  prone_fraction(b[B_HIP_Z] + prev[S_DROP]))
         for i in range(1, 11):
             out += b[B_ARM_LEN] * abs(state[S_DROP + i] - prev[S_DROP + i])
     return out
@@ -423,6 +428,8 @@ def flag_distance(P) -> float:
     if b[B_MODEL] != 0.0:  # the stance, and both arms' joints, each moving the hand at most the arm's length out
         arms = sum(span(A_Q0 + j) for j in range(5)) + span(A_FWD)  # (a hanging arm follows the trunk's flexion)
         worker += (span(A_DROP) + 2.0 * float(b[B_ARM_LEN]) * arms) / spa
+        if float(b[B_HIP_Z]) + float(act[:, A_DROP].min(initial=0.0)) < PRONE_BEGIN_Z:
+            worker += float(scal[C_RHO]) * PRONE_TRAVEL  # tipping to prone may all happen in one step
     robot = float(P.cap_speed.max(initial=0.0)) * dt
     leaf = (worker + robot) / 2 ** (SWEEP_DEPTH + SWEEP_CERTIFIED)
     # a flagged part's certified ends average at most dtol + the leaf's travel term, and each end is a lower bound
