@@ -747,7 +747,7 @@ OPTIONS: list[Case] = [
     Case("fix-time-limit-nan", ("fix", "baseline", "--time-limit", "nan", "--out", "out"), 2, ("--time-limit",)),
     Case("fix-out-is-a-file", ("fix", "baseline", "--out", "in/victim.txt"), 2, ("--out", "not a directory")),
     Case("fix-markup-name", ("fix", CELL, "--budget", "2", "--time-limit", "5", "--out", "out"), 0,
-         cell=_set("name", "<script>alert(1)</script>"),
+         cell=_set("name", "<script>alert(1)</script>"), group="fix-markup-name",
          check=lambda folder, out, err: _no_raw_markup(folder / "out" / "fix.html")),
     # issue 31: verify's checkpoint in --out is an input like any other; its options refuse markup and nonsense
     *(Case(f"verify-checkpoint-{kind}", ("verify", "baseline", "--phases", "cell", "--horizon", "1", "--workers", "1",
