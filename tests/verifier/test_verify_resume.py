@@ -42,6 +42,15 @@ def whole(tmp_path_factory):
     return cell, (root / "whole" / "verify.json").read_bytes()
 
 
+def _stop_after(subtrees: int):
+    """A progress callback that stops the run (as Ctrl-C does) once ``subtrees`` sub-trees are decided."""
+    def stop(done: int, total: int) -> None:
+        if done >= subtrees * 30 ** HORIZON:
+            raise KeyboardInterrupt
+
+    return stop
+
+
 def _lines(out) -> int:
     try:
         return len((out / CHECKPOINT).read_bytes().splitlines())
@@ -53,9 +62,7 @@ def test_ctrl_c_then_resume_gives_the_same_bytes(whole, tmp_path):
     cell, expected = whole
     out = tmp_path / "out"
 
-    def stop(done: int, total: int) -> None:
-        if done >= 10 * 30 ** HORIZON:
-            raise KeyboardInterrupt
+    stop = _stop_after(10)
 
     with pytest.raises(KeyboardInterrupt):
         cellstress.verify(cell, horizon=HORIZON, phases=PHASES, out=out, progress=stop)
@@ -107,9 +114,7 @@ def test_a_line_cut_short_is_dropped(whole, tmp_path):
     cell, expected = whole
     out = tmp_path / "out"
 
-    def stop(done: int, total: int) -> None:
-        if done >= 8 * 30 ** HORIZON:
-            raise KeyboardInterrupt
+    stop = _stop_after(8)
 
     with pytest.raises(KeyboardInterrupt):
         cellstress.verify(cell, horizon=HORIZON, phases=PHASES, out=out, progress=stop)
@@ -130,9 +135,7 @@ def test_a_foreign_or_damaged_checkpoint_is_refused(whole, tmp_path, capsys, cha
     cell, _ = whole
     out = tmp_path / "out"
 
-    def stop(done: int, total: int) -> None:
-        if done >= 3 * 30 ** HORIZON:
-            raise KeyboardInterrupt
+    stop = _stop_after(3)
 
     with pytest.raises(KeyboardInterrupt):
         cellstress.verify(cell, horizon=HORIZON, phases=PHASES, out=out, progress=stop)
@@ -155,9 +158,7 @@ def test_on_ray_the_same_bytes_and_resumes_from_a_local_run(whole, tmp_path):
     cell, expected = whole
     out = tmp_path / "out"
 
-    def stop(done: int, total: int) -> None:
-        if done >= 10 * 30 ** HORIZON:
-            raise KeyboardInterrupt
+    stop = _stop_after(10)
 
     with pytest.raises(KeyboardInterrupt):
         cellstress.verify(cell, horizon=HORIZON, phases=PHASES, out=out, progress=stop)

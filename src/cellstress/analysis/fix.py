@@ -23,6 +23,8 @@ import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+import numpy as np
+
 from cellstress.analysis.check_rows import CheckRow, check_rows
 from cellstress.analysis.iso13855 import StaticCheck, check_cell
 from cellstress.analysis.program_check import check_programs
@@ -39,6 +41,7 @@ from cellstress.analysis.safe_speed import MoveSpeed, move_speeds, per_move_reme
 from cellstress.cell.load import Cell, parse_cell
 from cellstress.core.errors import CellstressError
 from cellstress.core.io import atomic_write_text
+from cellstress.robot.capsules import convex_hull_2d
 from cellstress.searchers import search
 from cellstress.sim.build import build_layout
 from cellstress.sim.simulator import Simulator
@@ -143,22 +146,14 @@ def footprint(cell: Cell) -> float:
 
 
 def hull_area(points: list[tuple[float, float]]) -> float:
-    """Area of the convex hull (Andrew's monotone chain, then the shoelace formula); 0 for fewer than 3 points."""
-    pts = sorted(set((float(x), float(y)) for x, y in points))
-    if len(pts) < 3:
+    """Area of the convex hull (``robot.capsules.convex_hull_2d``, then the shoelace formula); 0 for fewer than
+    3 distinct points."""
+    try:
+        hull = convex_hull_2d(np.asarray(points, dtype=float).reshape(-1, 2))
+    except ValueError:
         return 0.0
-
-    def half(seq):
-        out: list[tuple[float, float]] = []
-        for p in seq:
-            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
-                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 0:
-                out.pop()
-            out.append(p)
-        return out
-
-    hull = half(pts)[:-1] + half(reversed(pts))[:-1]
-    return abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(hull, hull[1:] + hull[:1], strict=True))) / 2
+    x, y = hull[:, 0], hull[:, 1]
+    return float(abs(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y)) / 2)
 
 
 def retest(cell: Cell, budget: int, seed: int, time_limit: float) -> Retest:
