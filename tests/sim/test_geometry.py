@@ -20,6 +20,7 @@ from matplotlib.path import Path as MplPath
 from scipy.spatial.distance import cdist
 
 from cellstress.sim.geometry import (
+    EPS,
     point_in_polygon,
     point_segment_2d,
     polygon_distance,
@@ -32,7 +33,7 @@ ROUND = 1e-9  # round-off allowance [m] for coordinates of order 1 m (float64 gi
 N_SEG = 401  # samples per segment
 N_RECT = 81  # samples per rectangle side (a N_RECT x N_RECT grid)
 
-SETTINGS = settings(max_examples=300, deadline=None, derandomize=True,
+SETTINGS = settings(max_examples=3000, deadline=None, derandomize=False, database=None,
                     suppress_health_check=[HealthCheck.too_slow])
 
 coord = st.floats(-2.0, 2.0, allow_nan=False, allow_infinity=False)
@@ -50,6 +51,12 @@ def dist_to_segment(x, p, q):
     den = float(d @ d)
     t = 0.0 if den == 0.0 else float(np.clip((x - p) @ d / den, 0.0, 1.0))
     return float(np.linalg.norm(x - (p + t * d)))
+
+
+def unit(v):
+    """v's direction; x for a vector too short to have one (a norm that underflows would blow v up to 1e40)."""
+    n = float(np.linalg.norm(v))
+    return v / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
 
 
 @st.composite
@@ -79,10 +86,31 @@ def segment_pairs(draw):
     elif kind == "tiny":
         # millimetre-sized segments near each other
         scale = 1e-3
-        p2 = p1 + scale * (p2 - p1) / max(1e-300, np.linalg.norm(p2 - p1)) * draw(st.floats(0.0, 2.0))
-        q1 = p1 + scale * (q1 - p1) / max(1e-300, np.linalg.norm(q1 - p1))
-        q2 = p2 + scale * (q2 - p2) / max(1e-300, np.linalg.norm(q2 - p2))
+        p2 = p1 + scale * unit(p2 - p1) * draw(st.floats(0.0, 2.0))
+        q1 = p1 + scale * unit(q1 - p1)
+        q2 = p2 + scale * unit(q2 - p2)
+    # coordinates stay of the order of a cell (the round-off allowances below assume metres, not 1e40 m)
+    assert max(float(np.abs(v).max()) for v in (p1, q1, p2, q2)) <= 20.0
     return kind, p1, q1, p2, q2
+
+
+def point_slack(*segments):
+    """How far the kernel may be from the exact distance, by its own tolerance EPS (under a micrometre per metre
+    of segment; the simulator's margins are millimetres):
+
+    * a segment whose squared length is at most EPS is taken for its start point: up to its length;
+    * two segments whose angle has sin^2 at most EPS are taken as parallel (Ericson's s = 0): the distance
+      varies by at most sqrt(EPS) per metre along their overlap.
+    """
+    lengths = [float(np.linalg.norm(q - p)) for p, q in segments]
+    slack = sum(n for n in lengths if n * n <= EPS * (1.0 + 1e-9))
+    if len(segments) == 2 and min(lengths) > 1e-100:
+        (p1, q1), (p2, q2) = segments
+        u1, u2 = (q1 - p1) / lengths[0], (q2 - p2) / lengths[1]
+        sin2 = float(np.sum(np.cross(u1, u2) ** 2))
+        if sin2 <= EPS * (1.0 + 1e-6):
+            slack += np.sqrt(EPS) * max(lengths)
+    return slack
 
 
 def check_segment_segment(p1, q1, p2, q2):
@@ -90,14 +118,15 @@ def check_segment_segment(p1, q1, p2, q2):
     d2 = segment_segment(p1, q1, p2, q2, c1, c2)
     assert np.isfinite(d2) and d2 >= 0.0
     d = np.sqrt(d2)
+    slack = point_slack((p1, q1), (p2, q2))
     # the closest points are on the segments and d apart
-    assert dist_to_segment(c1, p1, q1) <= ROUND
-    assert dist_to_segment(c2, p2, q2) <= ROUND
+    assert dist_to_segment(c1, p1, q1) <= ROUND + slack
+    assert dist_to_segment(c2, p2, q2) <= ROUND + slack
     assert abs(np.linalg.norm(c1 - c2) - d) <= ROUND
     # no sampled pair is closer than d; and d is not above the sampled minimum by more than the sampling error
     brute = cdist(samples(p1, q1), samples(p2, q2)).min()
     tol = (np.linalg.norm(q1 - p1) + np.linalg.norm(q2 - p2)) / (2 * (N_SEG - 1))
-    assert d <= brute + ROUND, f"segment_segment {d} > brute force {brute}"
+    assert d <= brute + ROUND + slack, f"segment_segment {d} > brute force {brute}"
     assert d >= brute - tol - ROUND, f"segment_segment {d} < brute force {brute} - {tol}"
     return d, c1, c2
 
@@ -105,17 +134,18 @@ def check_segment_segment(p1, q1, p2, q2):
 @SETTINGS
 @given(segment_pairs())
 @example(("parallel", np.zeros(3), np.array([0.0, 0.0, 2.0]), np.zeros(3), np.array([0.0, 0.0, -2e-9])))
+@example(("general", np.zeros(3), np.zeros(3), np.zeros(3), np.array([0.0, 0.0, 2.755e-8])))
+@example(("general", np.zeros(3), np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0]), np.array([0.0, 1e-7, 0.0])))
 def test_segment_segment_matches_brute_force(pair):
     kind, p1, q1, p2, q2 = pair
     d, _, _ = check_segment_segment(p1, q1, p2, q2)
     if kind == "crossing":
-        assert d <= ROUND
-    # symmetric in the two segments and in each segment's direction; a segment of a few nanometres may be taken
-    # for either of its ends (the full suite's examples included one 2e-9 m long, parallel to the other: 2e-9 m
-    # apart one way, 0 the other), so the allowance grows by the shorter segment's length below a micrometre
+        assert d <= ROUND + point_slack((p1, q1), (p2, q2))
+    # symmetric in the two segments and in each segment's direction; a segment under a micrometre is taken for
+    # one of its ends, which one depending on the direction (the full suite drew one 2e-9 m long, parallel to
+    # the other: 2e-9 m apart one way, 0 the other)
     c1, c2 = np.zeros(3), np.zeros(3)
-    short = min(np.linalg.norm(q1 - p1), np.linalg.norm(q2 - p2))
-    allow = ROUND + (short if short < 1e-6 else 0.0)
+    allow = ROUND + point_slack((p1, q1), (p2, q2))
     for args in ((p2, q2, p1, q1), (q1, p1, q2, p2)):
         assert abs(np.sqrt(segment_segment(*args, c1, c2)) - d) <= allow
 
@@ -210,6 +240,10 @@ def test_segment_rectangle_matches_brute_force(case):
     c1, c2 = np.full(3, np.nan), np.full(3, np.nan)
     d = segment_rectangle(a, b, rect, c1, c2, np.zeros((4, 3)))
     assert np.isfinite(d) and d >= 0.0
+    # the kernel measures the segment against the rectangle's four edges, each within its own tolerance
+    x0, y0, x1, y1, zlo, zhi = rect
+    corners = [np.array(c) for c in ((x0, y0, zlo), (x1, y1, zlo), (x1, y1, zhi), (x0, y0, zhi))]
+    slack = max(point_slack((a, b), (corners[k], corners[(k + 1) % 4])) for k in range(4))
     # closest points on the segment / on the rectangle and d apart
     assert dist_to_segment(c1, a, b) <= ROUND
     assert dist_to_rect(c2, rect) <= ROUND
@@ -220,17 +254,17 @@ def test_segment_rectangle_matches_brute_force(case):
     w = np.hypot(rect[2] - rect[0], rect[3] - rect[1])
     h = rect[5] - rect[4]
     tol = np.linalg.norm(b - a) / (2 * 200) + 0.5 * np.hypot(w, h) / (N_RECT - 1)
-    assert d <= brute + ROUND, f"segment_rectangle {d} > brute force {brute}"
+    assert d <= brute + ROUND + slack, f"segment_rectangle {d} > brute force {brute}"
     assert d >= brute - tol - ROUND, f"segment_rectangle {d} < brute force {brute} - {tol}"
     # tighter: samples of the segment against the exact point-rectangle distance
     fine = dist_to_rect(samples(a, b, 1001), rect).min()
-    assert d <= fine + ROUND
+    assert d <= fine + ROUND + slack
     assert d >= fine - np.linalg.norm(b - a) / (2 * 1000) - ROUND
     if kind == "piercing":
-        assert d <= ROUND
+        assert d <= ROUND + slack
     # a strict crossing of the plane inside the rectangle means contact
     if segment_crosses_rectangle(a, b, rect):
-        assert d <= ROUND
+        assert d <= ROUND + slack
 
 
 def test_segment_rectangle_known_values():

@@ -138,7 +138,8 @@ def segment_rectangle_xyz(ax, ay, az, bx, by, bz, x0, y0, x1, y1, zlo, zhi):
     # signed distances of the endpoints from the rectangle's plane
     sa = (ax - x0) * nx + (ay - y0) * ny
     sb = (bx - x0) * nx + (by - y0) * ny
-    if sa * sb <= 0.0 and sa != sb:
+    # signs, not the product: two tiny distances of one sign multiply to 0.0 (underflow) and would pass
+    if ((sa <= 0.0 and sb >= 0.0) or (sa >= 0.0 and sb <= 0.0)) and sa != sb:
         t = sa / (sa - sb)
         cx, cy, cz = ax + t * (bx - ax), ay + t * (by - ay), az + t * (bz - az)
         u = (cx - x0) * ux + (cy - y0) * uy
@@ -214,7 +215,7 @@ def segment_crosses_rectangle(a, b, rect):
     nx, ny = -uy, ux
     sa = (a[0] - x0) * nx + (a[1] - y0) * ny
     sb = (b[0] - x0) * nx + (b[1] - y0) * ny
-    if sa * sb >= 0.0:
+    if not ((sa < 0.0 < sb) or (sb < 0.0 < sa)):  # strictly opposite signs (a product may underflow)
         return False
     t = sa / (sa - sb)
     cx, cy, cz = a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])

@@ -56,7 +56,7 @@ def _panel_across(fences, i, ax, ay, az, bx, by, bz):
     nx, ny = -uy, ux
     sa = (ax - fences[i, 0]) * nx + (ay - fences[i, 1]) * ny
     sb = (bx - fences[i, 0]) * nx + (by - fences[i, 1]) * ny
-    if sa * sb >= 0.0:
+    if not ((sa < 0.0 < sb) or (sb < 0.0 < sa)):  # strictly opposite signs (a product may underflow)
         return False
     t = sa / (sa - sb)
     cx, cy, cz = ax + t * (bx - ax), ay + t * (by - ay), az + t * (bz - az)
