@@ -88,17 +88,35 @@ def test_bad_input_is_one_error_line(args, tmp_path, capsys):
 
 
 def test_a_row_no_candidate_answers_exits_1(tmp_path, capsys):
-    """The baseline with its bay curtain's lowest beam raised to 0.6 m: only its crawl-under row fails, and no
-    candidate kind answers that row (docs/fix.md): exit 1, no proposal, the JUnit verdict case fails."""
+    """The baseline's scanner given a 150 mm resolution: ISO 13855 6.3 wants its plane at least 15 (150 - 50) =
+    1500 mm high and at most 300 mm: no height meets both, and no candidate kind changes a resolution
+    (docs/fix.md): exit 1, no proposal, the JUnit verdict case fails."""
+    text = Path(builtin_file("baseline")).read_text()
+    assert text.count("    height: 0.3\n") == 1
+    cell = tmp_path / "coarse.yaml"
+    cell.write_text(text.replace("    height: 0.3\n", "    height: 0.3\n    resolution_mm: 150\n"))
+    out = tmp_path / "out"
+    assert main(["fix", str(cell), "--out", str(out), *ARGS, "--junit", str(tmp_path / "j.xml")]) == 1
+    doc = json.loads((out / "fix.json").read_text())
+    assert doc["failing_before"] == ["front-scanner-mounting"] and doc["candidates"] == []
+    assert not doc["needs_nothing"] and not list(out.glob("proposal-*.yaml"))
+    root = validate_junit((tmp_path / "j.xml").read_bytes())
+    assert [c.get("name") for c in root.iter("testcase")] == ["fix"] and len(list(root.iter("failure"))) == 1
+    assert "NO PROPOSAL WORKS" in capsys.readouterr().out
+
+
+def test_a_curtain_a_body_crawls_under_gets_its_beam_lowered(tmp_path):
+    """The baseline with its bay curtain's lowest beam raised to 0.6 m: only its crawl-under row fails (ISO
+    13855 6.2: at most 300 mm); the device-height candidate puts the beam at 300 mm and is kept."""
     text = Path(builtin_file("baseline")).read_text()
     assert text.count("    bottom: 0.2") == 1
     cell = tmp_path / "crawl.yaml"
     cell.write_text(text.replace("    bottom: 0.2", "    bottom: 0.6"))
     out = tmp_path / "out"
-    assert main(["fix", str(cell), "--out", str(out), *ARGS, "--junit", str(tmp_path / "j.xml")]) == 1
+    assert main(["fix", str(cell), "--out", str(out), *ARGS]) == 0
     doc = json.loads((out / "fix.json").read_text())
-    assert doc["failing_before"] == ["bay-curtain-crawl-under"] and doc["candidates"] == [] and not doc["needs_nothing"]
-    assert not list(out.glob("proposal-*.yaml"))
-    root = validate_junit((tmp_path / "j.xml").read_bytes())
-    assert [c.get("name") for c in root.iter("testcase")] == ["fix"] and len(list(root.iter("failure"))) == 1
-    assert "NO PROPOSAL WORKS" in capsys.readouterr().out
+    assert doc["failing_before"] == ["bay-curtain-crawl-under"]
+    (c,) = doc["candidates"]
+    assert c["kind"] == "device-height" and c["kept"] and c["answers"] == ["bay-curtain-crawl-under"]
+    assert "from 600 to 300 mm" in c["change"]
+    assert main(["check", str(out / "proposal-1.yaml")]) == 0

@@ -10,8 +10,9 @@ A candidate is **kept** when the changed cell passes ``check`` (every row) and i
 
 Cost, the ranking (cheapest first, docs/fix.md): cycle time added [s], then floor area added [m^2] (the cell's
 footprint: the convex hull of its fences and devices), then parts added, then the order the candidates were
-tried in (settings named by rows, the device moved alone, the device moved with the cell, the program slowed
-per move: ``analysis.safe_speed``, also where check passes and the re-test finds a hazard). A move
+tried in (settings named by rows; ``analysis.way_remedies``' device heights, closed gaps, raised curtain tops
+and lowered panels; the device moved alone; the device moved with the cell; the program slowed per move:
+``analysis.safe_speed``, also where check passes and the re-test finds a hazard). A move
 that passes check while its re-test still finds a hazard is tried again ``EXTRA`` metres further. Wall-clock
 time is kept out of every file: the same inputs give the same bytes, unless a verify ends within a hair of
 the time limit on one run and not on another.
@@ -26,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from cellstress.analysis.check_rows import CheckRow, check_rows
+from cellstress.analysis.espe_rules import CurtainReachOver
 from cellstress.analysis.iso13855 import StaticCheck, check_cell
 from cellstress.analysis.program_check import check_programs
 from cellstress.analysis.remedies import (
@@ -35,9 +37,11 @@ from cellstress.analysis.remedies import (
     device_move,
     moved,
     panel_move,
+    reach_over_move,
     setting_remedies,
 )
 from cellstress.analysis.safe_speed import MoveSpeed, move_speeds, per_move_remedy
+from cellstress.analysis.way_remedies import closed_gaps, device_heights, lowered_panels, raised_tops
 from cellstress.cell.load import Cell, parse_cell
 from cellstress.core.errors import CellstressError
 from cellstress.core.io import atomic_write_text
@@ -194,7 +198,7 @@ def _moves(cell: Cell, static: StaticCheck, whole: bool, scratch: Path) -> tuple
     moves: list[Move] = []
     current = static
     for _ in range(ROUNDS):
-        new = [m for d in current.devices if (m := device_move(d)) is not None]
+        new = _device_moves(current)
         if whole:  # a fence panel too close for ISO 13857 Table 2 moves with the walls that meet it
             panels = [pr for a in (current.approach, *current.robot_approaches) for pr in a.reach_over_fails]
             new += list({m.line: m for pr in panels if (m := panel_move(pr)) is not None}.values())
@@ -207,6 +211,20 @@ def _moves(cell: Cell, static: StaticCheck, whole: bool, scratch: Path) -> tuple
             break  # the candidate's own evaluation reports it
         current = checked(c)[1]
     return tuple(moves)
+
+
+def _device_moves(static: StaticCheck) -> list[Move]:
+    """Each short device's move (ISO 13855 S, and for a curtain reached over its top S_RO): one per device, the
+    larger where both rows fail, so one edge is not moved twice."""
+    rows = {d.device: d for d in static.devices}
+    found = [m for d in static.devices if (m := device_move(d)) is not None]
+    found += [m for r in static.access if isinstance(r, CurtainReachOver) and r.device in rows
+              and (m := reach_over_move(r, rows[r.device])) is not None]
+    best: dict[str, Move] = {}
+    for m in found:
+        if m.device not in best or m.delta > best[m.device].delta:
+            best[m.device] = m
+    return list(best.values())
 
 
 def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit: float = 30.0,
@@ -229,8 +247,14 @@ def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit
         return proposals[-1]
 
     if base.failing:
-        for r in setting_remedies(cell, static):
+        for r in setting_remedies(cell, static) + device_heights(cell, static) + closed_gaps(cell, static):
             evaluate(r)
+        for r in raised_tops(cell, static, lambda text, row: _passes(text, row, scratch)):
+            evaluate(r)
+        for tries in lowered_panels(cell, static):  # the least lowering first; a lower one only where it fails
+            for r in tries:
+                if evaluate(r).kept:
+                    break
         for whole in (False, True):
             moves = _moves(cell, static, whole, scratch)
             for extra in (0.0, *EXTRA):
@@ -248,6 +272,15 @@ def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit
     if scratch.exists():
         scratch.unlink()
     return replace(result, candidates=tuple(proposals))
+
+
+def _passes(text: str, row: str, scratch: Path) -> bool:
+    """Whether the cell file ``text`` is valid and passes check row ``row``."""
+    try:
+        c = _parse(Remedy("", "", (), 0, text), scratch)
+    except CellstressError:
+        return False
+    return row not in checked(c)[0].failing
 
 
 def _evaluate(number: int, r: Remedy, base: Checked, out: Path, budget: int, seed: int, time_limit: float) \

@@ -58,6 +58,8 @@ class Opening:
     inside: tuple[float, float]  # ... and one on the other side
     covered_by: tuple[str, ...] = ()  # devices that see a body passing it
     sim_note: str = ""  # what the simulated worker cannot do here ("": it can pass)
+    fence: int = -1  # index (from 0) of the raised fence ("under") or of the fence whose free end opens the gap
+    door: str = ""  # the guard door whose leaf is raised ("under" a door)
 
     @property
     def shape(self) -> str:
@@ -185,20 +187,21 @@ def _ahead(fence, own: int, end, q) -> bool:
     return (q[0] - end[0]) * ux + (q[1] - end[1]) * uy >= -1e-9 * math.hypot(ux, uy)
 
 
-def candidate_openings(spec) -> list[tuple[str, str, tuple, tuple, float]]:
-    """(kind, where, start, end, clear height) of every opening to look at, without duplicates."""
+def candidate_openings(spec) -> list[tuple[str, str, tuple, tuple, float, int, str]]:
+    """(kind, where, start, end, clear height, fence index, door name) of every opening to look at, without
+    duplicates (``Opening.fence``, ``Opening.door``)."""
     barriers = _barriers(spec)
     out, seen = [], set()
     for i, f in enumerate(spec.fences, 1):
         if f.bottom > 0.0:
             for j, (a, b) in enumerate(zip(f.points, f.points[1:], strict=False), 1):
                 out.append(("under", f"under fence {i} panel {j}", tuple(map(float, a)), tuple(map(float, b)),
-                            float(f.bottom)))
+                            float(f.bottom), i - 1, ""))
     for d in spec.devices:
         for p in d.primitives():
             if isinstance(p, DoorLeaf) and p.bottom > 0.0:
                 out.append(("under", f"under door {d.name}", tuple(map(float, p.start)), tuple(map(float, p.end)),
-                            float(p.bottom)))
+                            float(p.bottom), -1, d.name))
     for i, end, own in _free_ends(spec, barriers):
         for k, br in enumerate(barriers):  # each segment of each barrier: a fence's own far panels included
             for j, seg in enumerate(br.segments):
@@ -212,7 +215,7 @@ def candidate_openings(spec) -> list[tuple[str, str, tuple, tuple, float]]:
                     continue
                 seen.add(key)
                 top = min(float(spec.fences[i].top), br.top)
-                out.append(("gap", f"gap from fence {i + 1}'s end to {br.name}", end, q, top))
+                out.append(("gap", f"gap from fence {i + 1}'s end to {br.name}", end, q, top, i, ""))
     return out
 
 
@@ -269,7 +272,7 @@ def crawl_note(articulated: bool, bottom: float) -> str:
 def perimeter_openings(spec, fill: FloorFill, body_radius: float) -> tuple[Opening, ...]:
     """The openings of ``candidate_openings`` that lead from the start's unseen region to floor outside it."""
     out = []
-    for kind, where, a, b, top in candidate_openings(spec):
+    for kind, where, a, b, top, fence, door in candidate_openings(spec):
         width = math.hypot(b[0] - a[0], b[1] - a[1])
         if width <= JOIN_TOL:
             continue
@@ -295,5 +298,5 @@ def perimeter_openings(spec, fill: FloorFill, body_radius: float) -> tuple[Openi
         out.append(Opening(kind, where, (round(a[0], 4), round(a[1], 4)), (round(b[0], 4), round(b[1], 4)),
                            width, top, (round(mid[0], 4), round(mid[1], 4)), (round(mid_in[0], 4),
                                                                               round(mid_in[1], 4)),
-                           covered, note))
+                           covered, note, fence, door))
     return tuple(out)

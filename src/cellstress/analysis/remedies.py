@@ -27,6 +27,7 @@ from pathlib import Path
 
 import yaml
 
+from cellstress.analysis.espe_rules import CurtainReachOver
 from cellstress.analysis.iso13855 import DeviceCheck, StaticCheck
 from cellstress.cell.load import Cell, builtin_text, safe_load_yaml
 from cellstress.core.io import read_input_bytes
@@ -41,7 +42,7 @@ class Remedy:
     """One candidate change: what it is (in words), which check rows it answers, and the whole changed cell."""
 
     kind: str  # 'move-device', 'move-cell', 'guard-locking', 'manual-restart', 'muting-end', 'ssm-times',
-    # 'wire', 'slow-per-move'
+    # 'wire', 'slow-per-move', and analysis.way_remedies' 'lower-panel', 'close-gap', 'raise-top', 'device-height'
     change: str  # e.g. "move front-mat's edge (-1.5, 2.3)-(1.5, 2.3) 0.47 m outward (+y)"
     rows: tuple[str, ...]  # the failing check rows (or 'hazard') it answers
     parts_added: int  # new devices or fences (every remedy here adds none; the field keeps the cost honest)
@@ -81,7 +82,7 @@ def _robots(doc: dict) -> list[dict]:
     return out + [r for r in doc.get("robots") or () if isinstance(r, dict)]
 
 
-def _dump(doc: dict) -> str:
+def dump_cell(doc: dict) -> str:
     return yaml.safe_dump(doc, sort_keys=False, allow_unicode=True, width=120, default_flow_style=None)
 
 
@@ -89,7 +90,7 @@ def _devices(doc: dict) -> list[dict]:
     return [d for d in doc.get("devices") or () if isinstance(d, dict)]
 
 
-def _device(doc: dict, name: str) -> dict | None:
+def device_entry(doc: dict, name: str) -> dict | None:
     return next((d for d in _devices(doc) if d.get("name") == name), None)
 
 
@@ -123,6 +124,17 @@ def device_move(d: DeviceCheck) -> Move | None:
     n = (round(n[0], 12) + 0.0, round(n[1], 12) + 0.0)
     delta = math.ceil((d.required - d.actual + MARGIN) * 100.0 - 1e-9) / 100.0
     return Move(d.device, edge, n, n[0] * x0 + n[1] * y0, delta)
+
+
+def reach_over_move(r: CurtainReachOver, d: DeviceCheck) -> Move | None:
+    """How far to move a light curtain (``d``: its own ISO 13855 row, for the edge and the hazard's side) whose
+    top can be reached over, so that the zone lies S_RO (``r.required``, ISO 13855 Table 1) behind its line."""
+    if r.ok or r.device != d.device or not (math.isfinite(r.required) and math.isfinite(r.behind)):
+        return None
+    m = device_move(replace(d, ok=False, actual=0.0, required=0.0))  # the edge and its outward normal only
+    if m is None:
+        return None
+    return replace(m, delta=math.ceil((r.required - r.behind + MARGIN) * 100.0 - 1e-9) / 100.0)
 
 
 def panel_move(pr) -> Move | None:
@@ -176,7 +188,7 @@ def apply_move(doc: dict, m: Move, whole: bool) -> None:
     worker seen from the first step, a test of nothing."""
     whole = whole or _is_panel(m)
     if not whole:
-        dev = _device(doc, m.device)
+        dev = device_entry(doc, m.device)
         if dev is not None:
             _shift_device(dev, m, warning=False)
     else:
@@ -214,7 +226,7 @@ def setting_remedies(cell: Cell, static: StaticCheck) -> list[Remedy]:
     out: list[Remedy] = []
     base = cell_document(cell)
     for d in static.devices:
-        dev = _device(base, d.device)
+        dev = device_entry(base, d.device)
         if d.ok or dev is None:
             continue
         if dev.get("type") == "guard-door" and not dev.get("guard_locking", False):
@@ -231,11 +243,11 @@ def setting_remedies(cell: Cell, static: StaticCheck) -> list[Remedy]:
                 out.append(_setting(base, d.device, "ssm-times", times, (d.device,),
                                     f"configure {d.device}'s controller with the real times ({words})"))
     for r in static.restarts:
-        if not r.ok and _device(base, r.device) is not None:
+        if not r.ok and device_entry(base, r.device) is not None:
             out.append(_setting(base, r.device, "manual-restart", {"restart": "manual"}, (f"{r.device}-restart",),
                                 f"manual restart on {r.device} (a reset outside the cell)"))
     for m in static.mutings:
-        dev = _device(base, m.device)
+        dev = device_entry(base, m.device)
         if not m.ok and dev is not None and isinstance(dev.get("muting"), dict):
             muting = {**dev["muting"], "until": m.pallet_out}
             out.append(_setting(base, m.device, "muting-end", {"muting": muting}, (f"{m.device}-muting",),
@@ -246,10 +258,10 @@ def setting_remedies(cell: Cell, static: StaticCheck) -> list[Remedy]:
 
 def _setting(base: dict, device: str, kind: str, fields: dict, rows: tuple[str, ...], words: str) -> Remedy:
     doc = copy.deepcopy(base)
-    dev = _device(doc, device)
+    dev = device_entry(doc, device)
     if dev is not None:
         dev.update(copy.deepcopy(fields))
-    return Remedy(kind, words, rows, 0, _dump(doc))
+    return Remedy(kind, words, rows, 0, dump_cell(doc))
 
 
 def _wiring(base: dict, static: StaticCheck) -> list[Remedy]:
@@ -262,11 +274,11 @@ def _wiring(base: dict, static: StaticCheck) -> list[Remedy]:
             stops = dev.get("stops")
             if isinstance(stops, list) and a.robot not in stops:
                 doc = copy.deepcopy(base)
-                target = _device(doc, dev.get("name"))
+                target = device_entry(doc, dev.get("name"))
                 target["stops"] = [*stops, a.robot]
                 out.append(Remedy("wire", f"wire {dev.get('name')} to robot {a.robot} (it stops "
                                   f"{', '.join(map(str, stops))} only)", (f"undetected-reach:{a.robot}",), 0,
-                                  _dump(doc)))
+                                  dump_cell(doc)))
     return out
 
 
@@ -279,7 +291,7 @@ def moved(cell: Cell, moves: tuple[Move, ...], whole: bool, extra: float = 0.0) 
         apply_move(doc, m, whole)
     rows = tuple(dict.fromkeys(m.device for m in moves))
     return Remedy("move-cell" if whole else "move-device", "; ".join(move_words(m, whole) for m in moves), rows, 0,
-                  _dump(doc))
+                  dump_cell(doc))
 
 
 def program_moves(cell: Cell) -> tuple[tuple[int, int, float], ...]:
@@ -311,4 +323,4 @@ def with_scales(cell: Cell, scales: dict[tuple[int, int], float], words: str,
         task.pop("speed_scale", None)
         task["speed_scales"] = [max(0.01, math.floor(scales.get((k, i), float(old[i])) * 1e4) / 1e4)
                                 for i in range(n)]
-    return Remedy("slow-per-move", words, ("hazard",), 0, _dump(doc))
+    return Remedy("slow-per-move", words, ("hazard",), 0, dump_cell(doc))

@@ -1,0 +1,174 @@
+"""Candidate changes that close a way in (``cellstress fix``), from ``check``'s openings and device rules.
+
+Each answers one failing row with the least change of its kind, and never looks at the cell's name:
+
+* **lower-panel**: an opening under a raised fence or door leaf that admits the whole body (ISO 13857: a slot
+  over 180 mm): its bottom lowered to 180 mm (the least that closes it to the body), else to the floor (where
+  a bottom edge still lets an arm under, ``check`` says so and only the floor passes). Two candidates, tried
+  in that order; ``fix`` stops at the first that works.
+* **close-gap**: a gap from a fence's free end to another barrier (or the floor's edge) that admits the body
+  unseen, or that is the entry of a device whose ISO 13855 distance there falls short (seen, too late): one
+  new fence panel across it, as high as the fence it continues; one part added. A gap that is a far enough
+  entry (the cell's way in) is never closed.
+* **raise-top**: a light curtain whose top beam can be reached over (ISO 13855 Table 1's C_RO): its top raised
+  to the lowest of Table 1's columns at which its reach-over row passes (found by ``check`` itself, columns
+  only: between columns the table gives the lower one's distances); none where even 2600 mm fails.
+* **device-height**: a curtain whose lowest beam lets a body crawl under (over 300 mm) or whose top beam can be
+  stepped over (under 900 mm): that beam moved to the limit (ISO 13855 6.2); a scanner's plane too low for
+  its resolution or high enough to crawl under: moved into 15 (d - 50)..300 mm where that range is not empty
+  (6.3; the field's own distance, which depends on the height, is then ``check``'s to judge).
+* moving a curtain back to S_RO is the ``move-device`` / ``move-cell`` candidate (``remedies.reach_over_move``).
+"""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Callable
+
+from cellstress.analysis.espe_rules import BeamHeights, CurtainReachOver, ScannerMounting
+from cellstress.analysis.iso13855 import StaticCheck
+from cellstress.analysis.openings import ON_TOL
+from cellstress.analysis.plane import point_segment
+from cellstress.analysis.remedies import Remedy, cell_document, device_entry, dump_cell
+from cellstress.cell.load import Cell
+from cellstress.core import iso13855 as I
+from cellstress.core.iso13857 import WHOLE_BODY_SLOT_MM
+
+SLOT = WHOLE_BODY_SLOT_MM / 1000.0  # m: ISO 13857's largest slot the whole body does not pass
+CRAWL_BEAM = I.CRAWL_UNDER_MAX_MM / 1000.0  # m: ISO 13855 6.2, a whole-body curtain's lowest beam at most this high
+STEP_BEAM = I.STEP_OVER_MIN_MM / 1000.0  # m: ISO 13855 6.2, its top beam at least this high
+
+
+def lowered_panels(cell: Cell, static: StaticCheck) -> list[tuple[Remedy, ...]]:
+    """For each failing opening under a raised fence or door: its bottom at 180 mm, then at the floor."""
+    base = cell_document(cell)
+    out, seen = [], set()
+    for o in static.openings:
+        if o.ok or o.kind != "under" or (o.fence, o.door) in seen:
+            continue
+        seen.add((o.fence, o.door))
+        if o.fence >= 0:
+            target, name = ("fence", o.fence), f"fence {o.fence + 1}"
+        elif o.door:
+            target, name = ("door", o.door), f"door {o.door}"
+        else:
+            continue
+        tries = []
+        for bottom in (b for b in (SLOT, 0.0) if b < o.height - 1e-9):
+            doc = copy.deepcopy(base)
+            where = _target(doc, target)
+            if where is None:
+                break
+            where["bottom"] = bottom
+            to = "to the floor" if bottom == 0.0 else f"to {bottom * 1000:.0f} mm (ISO 13857 whole body: a slot)"
+            tries.append(Remedy("lower-panel", f"lower {name}'s bottom edge from {o.height * 1000:.0f} mm {to}",
+                                ("whole-body-opening",), 0, dump_cell(doc)))
+        if tries:
+            out.append(tuple(tries))
+    return out
+
+
+def _target(doc: dict, target: tuple) -> dict | None:
+    kind, key = target
+    if kind == "fence":
+        fences = doc.get("fences") or []
+        return fences[key] if key < len(fences) and isinstance(fences[key], dict) else None
+    return device_entry(doc, key)
+
+
+def closed_gaps(cell: Cell, static: StaticCheck) -> list[Remedy]:
+    """For each gap from a fence's free end that the body passes unseen, or through which a device's entry is
+    too close to the hazard (the device sees it, too late): one panel across it, as high as that fence. A gap
+    whose entry is far enough (the cell's way in) is left open."""
+    base = cell_document(cell)
+    out = []
+    for o in static.openings:
+        if o.kind != "gap" or o.fence < 0 or o.fence >= len(cell.spec.fences):
+            continue
+        short = tuple(d.device for d in static.devices if not d.ok and any(
+            dist < d.required and _along(p0, p1, o.start, o.end) for p0, p1, dist in d.entries))
+        if o.ok and not short:
+            continue
+        top = float(cell.spec.fences[o.fence].top)
+        doc = copy.deepcopy(base)
+        doc.setdefault("fences", []).append({"points": [list(o.start), list(o.end)], "top": top})
+        (x0, y0), (x1, y1) = o.start, o.end
+        rows = short if o.ok else ("whole-body-opening", *short)
+        out.append(Remedy("close-gap", f"close the {o.where} with a fence panel ({x0:g}, {y0:g})-({x1:g}, {y1:g}), "
+                          f"{top:g} m high", rows, 1, dump_cell(doc)))
+    return out
+
+
+def _along(p0, p1, a, b) -> bool:
+    """Whether the segment p0-p1 lies along a-b (both its ends within ``ON_TOL`` of it)."""
+    return all(float(point_segment(x, y, a[0], a[1], b[0], b[1])[0]) <= ON_TOL for x, y in (p0, p1))
+
+
+def raised_tops(cell: Cell, static: StaticCheck, passes: Callable[[str, str], bool]) -> list[Remedy]:
+    """For each curtain whose reach-over row fails: its top at the lowest Table 1 column where the row passes.
+    ``passes(text, row)``: whether the cell file ``text`` passes check row ``row`` (the caller's check)."""
+    base = cell_document(cell)
+    out, seen = [], set()
+    for r in static.access:
+        if not isinstance(r, CurtainReachOver) or r.ok or r.device in seen:
+            continue
+        seen.add(r.device)
+        row = f"{r.device}-reach-over" + (f":{r.robot}" if r.robot else "")
+        columns = [b / 1000.0 for b in I.C_RO_B_MM if b / 1000.0 > r.top + 1e-9]
+
+        def text_at(top: float, device: str = r.device) -> str:
+            doc = copy.deepcopy(base)
+            device_entry(doc, device)["top"] = top
+            return dump_cell(doc)
+
+        lo, hi = 0, len(columns)  # Table 1's C_RO never grows with b: the passing columns are a suffix
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if passes(text_at(columns[mid]), row):
+                hi = mid
+            else:
+                lo = mid + 1
+        if lo < len(columns):
+            out.append(Remedy("raise-top", f"raise {r.device}'s top beam from {r.top * 1000:.0f} mm to "
+                              f"{columns[lo] * 1000:.0f} mm (ISO 13855 Table 1)", (row,), 0,
+                              text_at(columns[lo])))
+    return out
+
+
+def device_heights(cell: Cell, static: StaticCheck) -> list[Remedy]:
+    """For each curtain a body crawls under or steps over: the beam at ISO 13855 6.2's limit; for each scanner
+    whose plane is too low for its resolution or high enough to crawl under: the plane at the nearest height
+    that meets both, where one does (6.3: 15 (d - 50) mm <= H <= 300 mm)."""
+    base = cell_document(cell)
+    out = []
+    for r in static.access:
+        if isinstance(r, BeamHeights) and not (r.crawl_ok and r.step_ok):
+            fields, words, rows = {}, [], []
+            if not r.crawl_ok:
+                fields["bottom"] = CRAWL_BEAM
+                words.append(f"lowest beam from {r.bottom * 1000:.0f} to {CRAWL_BEAM * 1000:.0f} mm")
+                rows.append(f"{r.device}-crawl-under")
+            if not r.step_ok:
+                fields["top"] = STEP_BEAM
+                words.append(f"top beam from {r.top * 1000:.0f} to {STEP_BEAM * 1000:.0f} mm")
+                rows.append(f"{r.device}-step-over")
+            what = ", ".join(words) + " (ISO 13855 6.2)"
+        elif isinstance(r, ScannerMounting) and not r.ok:
+            lo, hi = r.min_height_mm / 1000.0, I.CRAWL_UNDER_MAX_MM / 1000.0
+            if lo > hi + 1e-9:
+                continue  # no height meets both: a finer resolution is the change, not a setting
+            height = min(max(r.height, lo), hi)
+            fields = {"height": round(height, 6)}
+            rows = [f"{r.device}-{w}" for w, ok in (("mounting", r.resolution_ok), ("crawl-under", r.crawl_ok))
+                    if not ok]
+            what = (f"scan plane from {r.height * 1000:.0f} to {height * 1000:.0f} mm (ISO 13855 6.3: "
+                    f"{lo * 1000:.0f}..{hi * 1000:.0f} mm for {r.resolution:g} mm)")
+        else:
+            continue
+        doc = copy.deepcopy(base)
+        dev = device_entry(doc, r.device)
+        if dev is None:
+            continue
+        dev.update(fields)
+        out.append(Remedy("device-height", f"{r.device}: {what}", tuple(rows), 0, dump_cell(doc)))
+    return out
