@@ -11,8 +11,15 @@ import yaml
 from cellstress.analysis.espe_rules import CurtainReachOver
 from cellstress.analysis.fix import _device_moves, checked
 from cellstress.analysis.remedies import MARGIN, moved
-from cellstress.analysis.way_remedies import closed_gaps, device_heights, lowered_panels, raised_tops
+from cellstress.analysis.way_remedies import (
+    closed_gaps,
+    device_heights,
+    lowered_panels,
+    raised_fences,
+    raised_tops,
+)
 from cellstress.cell.load import builtin_file, load_cell, parse_cell
+from cellstress.core.iso13857 import TABLE_2
 
 
 def _cell_of(text, tmp_path, name="candidate.yaml"):
@@ -47,12 +54,12 @@ def test_a_curtain_reached_over_gets_the_lowest_top_that_passes(tmp_path):
     assert base.failing == ("front-curtain-reach-over",)
     seen = []
 
-    def passes(text, row):
-        seen.append(row)
-        return row not in _failing(text, tmp_path)
+    def static_of(text):
+        seen.append(text)
+        return checked(_cell_of(text, tmp_path))[1]
 
-    (r,) = raised_tops(cell, static, passes)
-    assert r.kind == "raise-top" and r.rows == ("front-curtain-reach-over",) and seen
+    (r,) = raised_tops(cell, static, static_of)
+    assert r.kind == "raise-top" and r.rows == ("front-curtain-reach-over",) and 0 < len(seen) <= 4  # bisected
     top = next(d for d in yaml.safe_load(r.text)["devices"] if d["name"] == "front-curtain")["top"]
     assert _failing(r.text, tmp_path) == ()
     columns = [b / 1000 for b in (900, 1000, 1100, 1200, 1300, 1400, 1600, 1800, 2000, 2200, 2400, 2600)]
@@ -104,3 +111,25 @@ def test_a_scanner_too_low_for_its_resolution_is_raised(tmp_path):
     (r,) = device_heights(cell, static)
     assert r.kind == "device-height" and "from 100 to 300 mm" in r.change
     assert _failing(r.text, tmp_path) == ()
+
+
+def test_a_fence_reached_over_is_raised_to_the_lowest_column_that_holds(tmp_path):
+    """reach-over: the hazard zone is too close behind the front panel for ISO 13857 Table 2 at its height; the
+    fence is raised to the lowest column of the table at which none of its panels fails, and the cell then
+    passes check (its twin moved the panel back 0.70 m instead, 2.10 m^2 of floor)."""
+    cell = load_cell("reach-over")
+    base, static = checked(cell)
+    assert "reach-over" in base.failing
+    (r,) = raised_fences(cell, static, lambda text: checked(_cell_of(text, tmp_path))[1])
+    assert r.kind == "raise-fence" and r.rows == ("reach-over",) and r.parts_added == 0
+    before = [f.top for f in cell.spec.fences]
+    after = [f["top"] for f in yaml.safe_load(r.text)["fences"]]
+    raised = [i for i, (a, b) in enumerate(zip(before, after, strict=True)) if a != b]
+    assert raised and all(after[i] * 1000 in TABLE_2.b_mm for i in raised)
+    assert _failing(r.text, tmp_path) == ()
+    for i in raised:  # one column lower fails again (unless the fence's own height is that column)
+        lower = [b / 1000 for b in TABLE_2.b_mm if before[i] < b / 1000 < after[i]]
+        if lower:
+            doc = yaml.safe_load(r.text)
+            doc["fences"][i]["top"] = lower[-1]
+            assert "reach-over" in _failing(yaml.safe_dump(doc), tmp_path)

@@ -41,7 +41,13 @@ from cellstress.analysis.remedies import (
     setting_remedies,
 )
 from cellstress.analysis.safe_speed import MoveSpeed, move_speeds, per_move_remedy
-from cellstress.analysis.way_remedies import closed_gaps, device_heights, lowered_panels, raised_tops
+from cellstress.analysis.way_remedies import (
+    closed_gaps,
+    device_heights,
+    lowered_panels,
+    raised_fences,
+    raised_tops,
+)
 from cellstress.cell.load import Cell, parse_cell
 from cellstress.core.errors import CellstressError
 from cellstress.core.io import atomic_write_text
@@ -246,10 +252,13 @@ def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit
         proposals.append(_evaluate(len(proposals) + 1, r, base, out, budget, seed, time_limit))
         return proposals[-1]
 
+    def static_of(text: str) -> StaticCheck | None:
+        return _static_of(text, scratch)
+
     if base.failing:
         for r in setting_remedies(cell, static) + device_heights(cell, static) + closed_gaps(cell, static):
             evaluate(r)
-        for r in raised_tops(cell, static, lambda text, row: _passes(text, row, scratch)):
+        for r in raised_tops(cell, static, static_of) + raised_fences(cell, static, static_of):
             evaluate(r)
         for tries in lowered_panels(cell, static):  # the least lowering first; a lower one only where it fails
             for r in tries:
@@ -274,13 +283,13 @@ def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit
     return replace(result, candidates=tuple(proposals))
 
 
-def _passes(text: str, row: str, scratch: Path) -> bool:
-    """Whether the cell file ``text`` is valid and passes check row ``row``."""
+def _static_of(text: str, scratch: Path) -> StaticCheck | None:
+    """The static check of the cell file ``text`` (written to ``scratch`` and read back), None if invalid."""
     try:
         c = _parse(Remedy("", "", (), 0, text), scratch)
     except CellstressError:
-        return False
-    return row not in checked(c)[0].failing
+        return None
+    return checked(c)[1]
 
 
 def _evaluate(number: int, r: Remedy, base: Checked, out: Path, budget: int, seed: int, time_limit: float) \

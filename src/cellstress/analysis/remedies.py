@@ -42,7 +42,8 @@ class Remedy:
     """One candidate change: what it is (in words), which check rows it answers, and the whole changed cell."""
 
     kind: str  # 'move-device', 'move-cell', 'guard-locking', 'manual-restart', 'muting-end', 'ssm-times',
-    # 'wire', 'slow-per-move', and analysis.way_remedies' 'lower-panel', 'close-gap', 'raise-top', 'device-height'
+    # 'wire', 'slow-per-move', and analysis.way_remedies' 'lower-panel', 'close-gap', 'raise-top', 'raise-fence',
+    # 'device-height'
     change: str  # e.g. "move front-mat's edge (-1.5, 2.3)-(1.5, 2.3) 0.47 m outward (+y)"
     rows: tuple[str, ...]  # the failing check rows (or 'hazard') it answers
     parts_added: int  # new devices or fences (every remedy here adds none; the field keeps the cost honest)

@@ -17,6 +17,9 @@ Each answers one failing row with the least change of its kind, and never looks 
   stepped over (under 900 mm): that beam moved to the limit (ISO 13855 6.2); a scanner's plane too low for
   its resolution or high enough to crawl under: moved into 15 (d - 50)..300 mm where that range is not empty
   (6.3; the field's own distance, which depends on the height, is then ``check``'s to judge).
+* **raise-fence**: fences with a panel the hazard zone is too close behind for ISO 13857 Table 2 (the
+  ``reach-over`` row): each raised to the lowest of the table's columns where none of its panels fails, found
+  by ``check`` the same way (moving the panel instead is ``fix``'s ``move-cell``).
 * moving a curtain back to S_RO is the ``move-device`` / ``move-cell`` candidate (``remedies.reach_over_move``).
 """
 
@@ -32,6 +35,7 @@ from cellstress.analysis.plane import point_segment
 from cellstress.analysis.remedies import Remedy, cell_document, device_entry, dump_cell
 from cellstress.cell.load import Cell
 from cellstress.core import iso13855 as I
+from cellstress.core import iso13857 as I13857
 from cellstress.core.iso13857 import WHOLE_BODY_SLOT_MM
 
 SLOT = WHOLE_BODY_SLOT_MM / 1000.0  # m: ISO 13857's largest slot the whole body does not pass
@@ -104,9 +108,22 @@ def _along(p0, p1, a, b) -> bool:
     return all(float(point_segment(x, y, a[0], a[1], b[0], b[1])[0]) <= ON_TOL for x, y in (p0, p1))
 
 
-def raised_tops(cell: Cell, static: StaticCheck, passes: Callable[[str, str], bool]) -> list[Remedy]:
+def _lowest(columns: list[float], ok: Callable[[float], bool]) -> float | None:
+    """The lowest of ascending ``columns`` where ``ok`` holds, bisecting (it holds on a suffix: a reach-over
+    table's distance never grows with the structure's height); None where it holds nowhere."""
+    lo, hi = 0, len(columns)
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if ok(columns[mid]):
+            hi = mid
+        else:
+            lo = mid + 1
+    return columns[lo] if lo < len(columns) else None
+
+
+def raised_tops(cell: Cell, static: StaticCheck, static_of: Callable[[str], StaticCheck | None]) -> list[Remedy]:
     """For each curtain whose reach-over row fails: its top at the lowest Table 1 column where the row passes.
-    ``passes(text, row)``: whether the cell file ``text`` passes check row ``row`` (the caller's check)."""
+    ``static_of(text)``: the check of the cell file ``text`` (None where it is no valid cell)."""
     base = cell_document(cell)
     out, seen = [], set()
     for r in static.access:
@@ -114,25 +131,56 @@ def raised_tops(cell: Cell, static: StaticCheck, passes: Callable[[str, str], bo
             continue
         seen.add(r.device)
         row = f"{r.device}-reach-over" + (f":{r.robot}" if r.robot else "")
-        columns = [b / 1000.0 for b in I.C_RO_B_MM if b / 1000.0 > r.top + 1e-9]
 
         def text_at(top: float, device: str = r.device) -> str:
             doc = copy.deepcopy(base)
             device_entry(doc, device)["top"] = top
             return dump_cell(doc)
 
-        lo, hi = 0, len(columns)  # Table 1's C_RO never grows with b: the passing columns are a suffix
-        while lo < hi:
-            mid = (lo + hi) // 2
-            if passes(text_at(columns[mid]), row):
-                hi = mid
-            else:
-                lo = mid + 1
-        if lo < len(columns):
+        def passes(top: float, row: str = row) -> bool:
+            after = static_of(text_at(top))
+            return after is not None and row not in after.failures()
+
+        top = _lowest([b / 1000.0 for b in I.C_RO_B_MM if b / 1000.0 > r.top + 1e-9], passes)
+        if top is not None:
             out.append(Remedy("raise-top", f"raise {r.device}'s top beam from {r.top * 1000:.0f} mm to "
-                              f"{columns[lo] * 1000:.0f} mm (ISO 13855 Table 1)", (row,), 0,
-                              text_at(columns[lo])))
+                              f"{top * 1000:.0f} mm (ISO 13855 Table 1)", (row,), 0, text_at(top)))
     return out
+
+
+def raised_fences(cell: Cell, static: StaticCheck, static_of: Callable[[str], StaticCheck | None]) -> list[Remedy]:
+    """One candidate raising every fence with a panel the hazard zone is too close behind (ISO 13857 Table 2,
+    the ``reach-over`` rows): each fence's top at the lowest of the table's columns where none of its panels
+    fails any more (the others as they are)."""
+    base = cell_document(cell)
+    fences = sorted({pr.panel.fence for a in (static.approach, *static.robot_approaches) for pr in a.reach_over_fails})
+    doc, words = copy.deepcopy(base), []
+    for f in fences:
+        entries = doc.get("fences") or []
+        if not 1 <= f <= len(entries) or not isinstance(entries[f - 1], dict):
+            continue
+        old = float(cell.spec.fences[f - 1].top)
+
+        def text_at(top: float, f: int = f) -> str:
+            trial = copy.deepcopy(base)
+            trial["fences"][f - 1]["top"] = top
+            return dump_cell(trial)
+
+        def passes(top: float, f: int = f) -> bool:
+            after = static_of(text_at(top))
+            return after is not None and not any(pr.panel.fence == f for a in (after.approach, *after.robot_approaches)
+                                                 for pr in a.reach_over_fails)
+
+        top = _lowest([b / 1000.0 for b in I13857.TABLE_2.b_mm if b / 1000.0 > old + 1e-9], passes)
+        if top is None:
+            return []  # (the table's last column has c = 0: only a broken check gets here)
+        entries[f - 1]["top"] = top
+        words.append(f"fence {f} from {old:g} m to {top:g} m")
+    if not words:
+        return []
+    rows = tuple(dict.fromkeys("reach-over" + (f":{a.robot}" if a.robot else "")
+                               for a in (static.approach, *static.robot_approaches) if a.reach_over_fails))
+    return [Remedy("raise-fence", "raise " + "; ".join(words) + " (ISO 13857 Table 2)", rows, 0, dump_cell(doc))]
 
 
 def device_heights(cell: Cell, static: StaticCheck) -> list[Remedy]:
