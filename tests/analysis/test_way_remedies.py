@@ -89,8 +89,10 @@ def test_a_gap_the_scanner_sees_too_late_is_closed_the_way_in_is_not(tmp_path):
     _, static = checked(cell)
     (r,) = closed_gaps(cell, static)
     assert r.kind == "close-gap" and r.parts_added == 1 and r.rows == ("front-scanner",)
-    new = yaml.safe_load(r.text)["fences"][-1]
-    assert sorted(map(tuple, new["points"])) == [(1.5, -0.2), (1.5, 0.8)] and new["top"] == 2.0
+    fences = yaml.safe_load(r.text)["fences"]
+    # the right wall drawn as one run again, as the baseline draws it: fence 2 continued, fence 3 joined to it
+    assert len(fences) == len(cell.spec.fences) - 1
+    assert fences[1]["points"] == [[1.5, 3.2], [1.5, -1.6], [0.6, -1.6]] and fences[1]["top"] == 2.0
     assert _failing(r.text, tmp_path) == ()
 
 
@@ -133,3 +135,17 @@ def test_a_fence_reached_over_is_raised_to_the_lowest_column_that_holds(tmp_path
             doc = yaml.safe_load(r.text)
             doc["fences"][i]["top"] = lower[-1]
             assert "reach-over" in _failing(yaml.safe_dump(doc), tmp_path)
+
+
+def test_a_gap_to_a_fence_of_another_height_is_closed_by_continuing_the_run_alone(tmp_path):
+    """s3-fence-gap with the fence the gap ends at made 2.2 m high: one run cannot have two heights, so fence 2
+    is continued to it and fence 3 stays a run of its own."""
+    text = Path(builtin_file("s3-fence-gap")).read_text()
+    old = "[[1.5, -0.2], [1.5, -1.6], [0.6, -1.6]], top: 2.0}"
+    assert text.count(old) == 1
+    cell = _cell_of(text.replace(old, old.replace("top: 2.0", "top: 2.2")), tmp_path, "taller.yaml")
+    _, static = checked(cell)
+    (r,) = closed_gaps(cell, static)
+    fences = yaml.safe_load(r.text)["fences"]
+    assert len(fences) == len(cell.spec.fences) and "joined" not in r.change
+    assert fences[1]["points"] == [[1.5, 3.2], [1.5, -0.2]] and fences[2]["top"] == 2.2

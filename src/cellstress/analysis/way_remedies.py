@@ -8,8 +8,9 @@ Each answers one failing row with the least change of its kind, and never looks 
   in that order; ``fix`` stops at the first that works.
 * **close-gap**: a gap from a fence's free end to another barrier (or the floor's edge) that admits the body
   unseen, or that is the entry of a device whose ISO 13855 distance there falls short (seen, too late): one
-  new fence panel across it, as high as the fence it continues; one part added. A gap that is a far enough
-  entry (the cell's way in) is never closed.
+  new fence panel across it, as high as the fence it continues; one part added. The panel is drawn as that
+  fence's run continued (and joined to the run it meets, where the heights agree), the wall as one run. A gap
+  that is a far enough entry (the cell's way in) is never closed.
 * **raise-top**: a light curtain whose top beam can be reached over (ISO 13855 Table 1's C_RO): its top raised
   to the lowest of Table 1's columns at which its reach-over row passes (found by ``check`` itself, columns
   only: between columns the table gives the lower one's distances); none where even 2600 mm fails.
@@ -95,11 +96,67 @@ def closed_gaps(cell: Cell, static: StaticCheck) -> list[Remedy]:
             continue
         top = float(cell.spec.fences[o.fence].top)
         doc = copy.deepcopy(base)
-        doc.setdefault("fences", []).append({"points": [list(o.start), list(o.end)], "top": top})
+        joined = _joined_run(doc, cell.spec.fences, o.fence, o.start, o.end)
+        if joined is None:
+            doc.setdefault("fences", []).append({"points": [list(o.start), list(o.end)], "top": top})
         (x0, y0), (x1, y1) = o.start, o.end
         rows = short if o.ok else ("whole-body-opening", *short)
+        how = "" if joined is None else f", fence {o.fence + 1} continued{joined}"
         out.append(Remedy("close-gap", f"close the {o.where} with a fence panel ({x0:g}, {y0:g})-({x1:g}, {y1:g}), "
-                          f"{top:g} m high", rows, 1, dump_cell(doc)))
+                          f"{top:g} m high{how}", rows, 1, dump_cell(doc)))
+    return out
+
+
+def _joined_run(doc: dict, fences, f: int, start, end) -> str | None:
+    """Draw the closing panel as part of fence ``f``'s own run (its free end ``start`` moved on to ``end``), and
+    where another fence of the same heights begins or ends at ``end``, that one too, with points in a straight
+    line dropped: the wall as one run, as a designer draws it (the simulator measures a wall of collinear runs
+    alike, but far more slowly: docs/architecture.md). Returns what else was joined ('' for nothing), None
+    where fence ``f``'s run cannot be continued (the panel is then a fence of its own)."""
+    entries = doc.get("fences") or []
+    if not all(isinstance(e, dict) for e in entries) or len(entries) != len(fences):
+        return None
+    own = [tuple(map(float, p)) for p in fences[f].points]
+    if _same(own[0], start):
+        own.reverse()
+    if not _same(own[-1], start):
+        return None
+    pts, other, words = own + [tuple(map(float, end))], None, ""
+    for g, fence in enumerate(fences):
+        ends = [tuple(map(float, p)) for p in fence.points]
+        if g == f or (fence.top, fence.bottom) != (fences[f].top, fences[f].bottom):
+            continue
+        if _same(ends[-1], end):
+            ends.reverse()
+        if _same(ends[0], end):  # its own (unrounded) points, not the opening's
+            pts, other, words = own + ends, g, f" and joined to fence {g + 1}"
+            break
+    entries[f]["points"] = [list(p) for p in _straightened(pts)]
+    if other is not None:
+        del entries[other]
+    return words
+
+
+def _same(a, b) -> bool:
+    """The same point, up to the 0.1 mm an opening's ends are rounded to (``analysis.openings``)."""
+    return abs(a[0] - b[0]) <= 1e-4 and abs(a[1] - b[1]) <= 1e-4
+
+
+def _straightened(pts: list) -> list:
+    """The polyline without points that lie on the straight line between their neighbours (or repeat one)."""
+    out = [pts[0]]
+    for k in range(1, len(pts)):
+        p = pts[k]
+        if p == out[-1]:
+            continue
+        if len(out) >= 2:
+            a, b = out[-2], out[-1]
+            cross = (b[0] - a[0]) * (p[1] - b[1]) - (b[1] - a[1]) * (p[0] - b[0])
+            dot = (b[0] - a[0]) * (p[0] - b[0]) + (b[1] - a[1]) * (p[1] - b[1])
+            if abs(cross) <= 1e-9 and dot > 0.0:
+                out[-1] = p
+                continue
+        out.append(p)
     return out
 
 
