@@ -110,8 +110,8 @@ def closed_gaps(cell: Cell, static: StaticCheck) -> list[Remedy]:
 def _joined_run(doc: dict, fences, f: int, start, end) -> str | None:
     """Draw the closing panel as part of fence ``f``'s own run (its free end ``start`` moved on to ``end``), and
     where another fence of the same heights begins or ends at ``end``, that one too, with points in a straight
-    line dropped: the wall as one run, as a designer draws it (the simulator measures a wall of collinear runs
-    alike, but far more slowly: docs/architecture.md). Returns what else was joined ('' for nothing), None
+    line dropped: the wall as one run, as a designer draws it (the simulator lets an arm through the seam of two
+    collinear runs: docs/architecture.md, "Known"). Returns what else was joined ('' for nothing), None
     where fence ``f``'s run cannot be continued (the panel is then a fence of its own)."""
     entries = doc.get("fences") or []
     if not all(isinstance(e, dict) for e in entries) or len(entries) != len(fences):

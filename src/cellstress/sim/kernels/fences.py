@@ -8,11 +8,6 @@ import numpy as np
 from cellstress.core.jit import njit
 from cellstress.sim.geometry import NO_REFCOUNT, point_segment_2d
 
-# m: a bend point this close to another panel is in it. Only a panel that continues the bent one in a straight
-# line puts the bend (1 cm past the end, ``nudge``) there: round-off, not a gap (ISO 13857 lets no finger
-# through a slot under 4 mm); a corner at any angle leaves it at least 1 cm x sin(angle) away.
-SEAM = 1e-6
-
 
 @njit(cache=True, error_model="numpy")
 def near_fences(P, W, margin):
@@ -67,19 +62,6 @@ def _panel_across(fences, i, ax, ay, az, bx, by, bz):
     cx, cy, cz = ax + t * (bx - ax), ay + t * (by - ay), az + t * (bz - az)
     u = ((cx - fences[i, 0]) * ux + (cy - fences[i, 1]) * uy) / (ux * ux + uy * uy)
     return 0.0 <= u <= 1.0 and fences[i, 4] <= cz <= fences[i, 5]
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _in_another_panel(fences, i, x, y, z):
-    """Whether the point lies in a panel other than i (within ``SEAM`` of it in plan, between its bottom and
-    top edges). A bend 1 cm past panel i's end lies there when another panel continues i in a straight line:
-    the two meet in a seam, and no hand passes round an end that is no end. Every panel is looked at, not
-    only the near ones: the one that continues a near panel may itself lie beyond the arm's reach."""
-    for j in range(fences.shape[0]):
-        if j != i and fences[j, 4] <= z <= fences[j, 5] and \
-                point_segment_2d(x, y, fences[j, 0], fences[j, 1], fences[j, 2], fences[j, 3]) <= SEAM:
-            return True
-    return False
 
 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
@@ -171,8 +153,7 @@ def _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
                 by = fences[i, 1] if edge == 1 else fences[i, 3]
                 length, t = (end0, t0) if edge == 1 else (end1, t1)
                 ex, ey, ez = bx + sgn * nudge * ux, by + sgn * nudge * uy, fences[i, 4] + t
-            if (length < best and not _in_another_panel(fences, i, ex, ey, ez)
-                    and _path_clear(fences, near, n_near, sx, sy, sz, ex, ey, ez)
+            if (length < best and _path_clear(fences, near, n_near, sx, sy, sz, ex, ey, ez)
                     and _path_clear(fences, near, n_near, ex, ey, ez, qx, qy, qz)):
                 best = length
     return best, around
