@@ -8,6 +8,10 @@ import numpy as np
 from cellstress.core.jit import njit
 from cellstress.sim.geometry import NO_REFCOUNT, point_segment_2d
 
+# m: two panel ends this close meet, and a panel whose direction is off another's by at most this (as a sine)
+# continues it in a straight line. Such a seam is closed: the hand passes neither through it nor round it.
+SEAM = 1e-6
+
 
 @njit(cache=True, error_model="numpy")
 def near_fences(P, W, margin):
@@ -17,6 +21,9 @@ def near_fences(P, W, margin):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def collect_near_fences(fences, sh, near, margin):
+    """The panels within ``margin`` of either shoulder (plan view), and every panel that continues one of
+    them in a straight line (``_continues``): a wall of collinear runs is near as a whole, so the hand's way
+    round it is the way round the wall, wherever its seams lie."""
     n = 0
     for f in range(fences.shape[0]):
         x0, y0, x1, y1 = fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3]
@@ -25,6 +32,24 @@ def collect_near_fences(fences, sh, near, margin):
         if d0 < margin or d1 < margin:
             near[n] = f
             n += 1
+    return _add_continuations(fences, near, n)
+
+
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def _add_continuations(fences, near, n):
+    """Append to ``near[:n]`` every panel that continues one of them in a straight line; the new count."""
+    k = 0
+    while k < n:
+        for end in range(2):
+            for j in range(fences.shape[0]):
+                if _continues(fences, near[k], end, j) >= 0:
+                    seen = False
+                    for m in range(n):
+                        seen = seen or near[m] == j
+                    if not seen:
+                        near[n] = j
+                        n += 1
+        k += 1
     return n
 
 
@@ -64,6 +89,42 @@ def _panel_across(fences, i, ax, ay, az, bx, by, bz):
     return 0.0 <= u <= 1.0 and fences[i, 4] <= cz <= fences[i, 5]
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _continues(fences, i, end, j):
+    """Which end of panel j (0 or 1) lies beyond panel i's end ``end`` (0: its first point, 1: its second) when
+    j lies in i's line and covers that end and the 1 cm beyond it (j continues i there, from that point or from
+    behind it: a run that meets i end to end, or one i overlaps, as a door leaf in its wall); -1 when not."""
+    ex, ey = fences[i, 2 * end], fences[i, 2 * end + 1]
+    ux, uy = ex - fences[i, 2 - 2 * end], ey - fences[i, 3 - 2 * end]
+    w2 = ux * ux + uy * uy
+    if j == i or w2 <= SEAM * SEAM:
+        return -1
+    # both of j's ends on i's line (squared, unnormalised: most panels fail here, and this runs at every step)
+    ax, ay = fences[j, 0] - ex, fences[j, 1] - ey
+    bx, by = fences[j, 2] - ex, fences[j, 3] - ey
+    tol2 = SEAM * SEAM * w2
+    if (ax * uy - ay * ux) ** 2 > tol2 or (bx * uy - by * ux) ** 2 > tol2:
+        return -1
+    w = np.sqrt(w2)
+    sa, sb = (ax * ux + ay * uy) / w, (bx * ux + by * uy) / w  # along i's outward direction, from its end
+    if min(sa, sb) <= SEAM and max(sa, sb) > SEAM:
+        return 0 if sa > sb else 1
+    return -1
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def continuation(fences, near, n_near, i, end):
+    """(m, far): the near panel ``near[m]`` that continues panel i in a straight line past its end ``end``
+    and which of its ends lies away from i (``_continues``); (-1, 0) if none does. Fence runs that meet end
+    to end make one wall: the way round is past the wall's ends, not past the seam. The near panels hold
+    every panel that continues one of them (``collect_near_fences``), so the whole wall is there."""
+    for m in range(n_near):
+        far = _continues(fences, i, end, near[m])
+        if far >= 0:
+            return m, far
+    return -1, 0
+
+
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def blocking_panel(fences, near, n_near, ax, ay, az, bx, by, bz):
     """The index into ``near`` of the first near fence panel across the straight segment a-b, or -1."""
@@ -89,22 +150,72 @@ def _panel_edges(fences, i, sx, sy, sz, qx, qy, qz):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _around_panel(fences, i, sx, sy, sz, qx, qy, qz, top, end0, end1):
+def _vertical_detour(sx, sy, sz, qx, qy, qz, x, y, z0, z1):
+    """The shortest path s -> e -> q with e on the vertical edge at (x, y) from height z0 up to z1."""
+    return _edge_detour(sx, sy, sz, qx, qy, qz, x, y, z0, 0.0, 0.0, 1.0, z1 - z0)[0]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _level_detour(fences, i, col, sx, sy, sz, qx, qy, qz):
+    """The shortest path s -> e -> q with e on panel i's horizontal edge at height fences[i, col] (5: the
+    top, 4: the bottom)."""
+    ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
+    w = np.sqrt(ux * ux + uy * uy)
+    return _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, col], ux / w, uy / w, 0.0,
+                        w)[0]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _bottom_detour(fences, i, sx, sy, sz, qx, qy, qz):
+    """``_level_detour`` over panel i's bottom edge where that edge counts (see ``_around_panel``), else inf."""
+    if fences[i, 4] < min(sz, qz):
+        return np.inf
+    return _level_detour(fences, i, 4, sx, sy, sz, qx, qy, qz)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _past_end(fences, near, n_near, i, end, sx, sy, sz, qx, qy, qz, own):
+    """A lower bound on the paths s -> q that cross the wall's plane beyond panel i's end ``end``, given the
+    detour ``own`` round that end edge: ``own`` where no panel continues i there; else the least detour
+    over the border of the wall the continuing panels make with i (their top and bottom edges, the steps
+    where two of them differ in height, the last one's far end edge)."""
+    best = np.inf
+    k, e = i, end
+    for _ in range(n_near):
+        m, far = continuation(fences, near, n_near, k, e)
+        if m < 0:
+            if k == i:
+                return own
+            return min(best, _vertical_detour(sx, sy, sz, qx, qy, qz, fences[k, 2 * e], fences[k, 2 * e + 1],
+                                              fences[k, 4], fences[k, 5]))
+        j = near[m]
+        # the steps in the wall's top and bottom where the two meet: at k's end, and at j's near end (the same
+        # point where j starts there; inside k where k overlaps j)
+        for x, y in ((fences[k, 2 * e], fences[k, 2 * e + 1]), (fences[j, 2 - 2 * far], fences[j, 3 - 2 * far])):
+            for z in range(4, 6):
+                if fences[k, z] != fences[j, z]:
+                    best = min(best, _vertical_detour(sx, sy, sz, qx, qy, qz, x, y, min(fences[k, z], fences[j, z]),
+                                                      max(fences[k, z], fences[j, z])))
+        best = min(best, _level_detour(fences, j, 5, sx, sy, sz, qx, qy, qz),
+                   _bottom_detour(fences, j, sx, sy, sz, qx, qy, qz))
+        k, e = j, far
+    return min(best, own)  # not reached: each continuation lies further along the line
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _around_panel(fences, near, n_near, i, sx, sy, sz, qx, qy, qz, top, end0, end1):
     """A lower bound on any path from s to q that passes panel i, when the straight path crosses it, given
     the panel's edge detours ``top``, ``end0``, ``end1`` (``_panel_edges``).
 
-    The path must cross the panel's plane outside the panel, and |s - c| + |c - q| over the plane is convex
-    with its minimum inside the panel, so the shortest such crossing lies on the panel's border: the least
-    of the four edge detours. The bottom edge counts only if s or q lies at or below it: otherwise a path
-    below the panel would have to dip under the panel and come back up, and the segment from such a crossing
-    to the straight path's crossing enters the panel through an end edge or the top, at no greater length."""
-    lb = min(top, end0, end1)
-    if fences[i, 4] < min(sz, qz):
-        return lb
-    ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
-    w = np.sqrt(ux * ux + uy * uy)
-    return min(lb, _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, 4], ux / w, uy / w,
-                                0.0, w)[0])
+    The path must cross the wall's plane outside the wall (panel i and the near panels that continue it in
+    a straight line, ``continuation``), and |s - c| + |c - q| over the plane is convex with its minimum
+    inside panel i, so the shortest such crossing lies on the wall's border: the least of its edge detours.
+    A panel's bottom edge counts only if s or q lies at or below it: otherwise a path below the panel would
+    have to dip under the panel and come back up, and the segment from such a crossing to the straight
+    path's crossing enters the panel through an end edge or the top, at no greater length."""
+    lb = min(top, _bottom_detour(fences, i, sx, sy, sz, qx, qy, qz))
+    lb = min(lb, _past_end(fences, near, n_near, i, 0, sx, sy, sz, qx, qy, qz, end0))
+    return min(lb, _past_end(fences, near, n_near, i, 1, sx, sy, sz, qx, qy, qz, end1))
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -121,7 +232,7 @@ def _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
     for m in range(n_near):
         if _panel_across(fences, near[m], sx, sy, sz, qx, qy, qz):
             e = _panel_edges(fences, near[m], sx, sy, sz, qx, qy, qz)
-            a = _around_panel(fences, near[m], sx, sy, sz, qx, qy, qz, e[0], e[2], e[4])
+            a = _around_panel(fences, near, n_near, near[m], sx, sy, sz, qx, qy, qz, e[0], e[2], e[4])
             around = a if a > around else around
             if first < 0:
                 first = m
@@ -153,6 +264,10 @@ def _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
                 by = fences[i, 1] if edge == 1 else fences[i, 3]
                 length, t = (end0, t0) if edge == 1 else (end1, t1)
                 ex, ey, ez = bx + sgn * nudge * ux, by + sgn * nudge * uy, fences[i, 4] + t
+                if length < best:
+                    c = continuation(fences, near, n_near, i, edge - 1)[0]
+                    if c >= 0 and fences[near[c], 4] <= ez <= fences[near[c], 5]:
+                        continue  # a seam: the bend lies in the panel that continues this one
             if (length < best and _path_clear(fences, near, n_near, sx, sy, sz, ex, ey, ez)
                     and _path_clear(fences, near, n_near, ex, ey, ez, qx, qy, qz)):
                 best = length

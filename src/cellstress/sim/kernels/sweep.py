@@ -304,8 +304,9 @@ def _certified(P, W):
                     ra[c, 2] + u * (rb[c, 2] - ra[c, 2])
                 d = reach_field_at(P.reach, origin, grid_h, W.sh, W.tr, side, px, py, pz) - slack - r
                 if n_near > 0 and not through and d < best:
+                    # only the lower bound is wanted: a zero cutoff returns it before any bend is tried
                     g_lb = fence_detour_bound(W.fences, W.near, np.int64(n_near), sx, sy, sz, px, py, pz,
-                                              np.inf)[1] - arm_len - half - r
+                                              0.0)[1] - arm_len - half - r
                     if g_lb > d:
                         d = g_lb
                 if d < best:
