@@ -5,6 +5,7 @@ the moves follow the geometry the way the fixed twins do."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -17,7 +18,7 @@ from cellstress.analysis.remedies import (
     panel_move,
     setting_remedies,
 )
-from cellstress.cell.load import load_cell, parse_cell
+from cellstress.cell.load import builtin_file, load_cell, parse_cell
 
 # flawed cell -> the kind of remedy that makes its check pass (a move, or the setting its failing row names)
 FLAWED = {"s1-scanner-width": "move-device", "mat-short": "move-device", "long-gripper": "move-cell",
@@ -119,3 +120,19 @@ def test_hull_area_against_shapes():
     assert hull_area([(0, 0), (1, 1), (2, 2)]) == pytest.approx(0.0)
     # the baseline: fences from x -1.5..1.5, y -1.6..3.2 (and the bay), so at least 3 x 4.8
     assert footprint(load_cell("baseline")) >= 3.0 * 4.8 - 1e-9
+
+
+def test_a_monitor_set_for_a_slower_robot_is_set_to_the_real_top_speed(tmp_path):
+    """ssm-ok's monitor configured for 0.8 m/s while the robot reaches 1.12 m/s on its path: the setting
+    candidate configures it with the real top speed (cm/s up), and its speed row passes."""
+    text = Path(builtin_file("ssm-ok")).read_text()
+    assert text.count("    max_speed: 1.2 ") == 1
+    path = tmp_path / "slow-monitor.yaml"
+    path.write_text(text.replace("    max_speed: 1.2 ", "    max_speed: 0.8 "))
+    cell = parse_cell(path.read_text(), str(path), tmp_path)
+    base, static = checked(cell)
+    assert "ssm-speed" in base.failing
+    (r,) = [r for r in setting_remedies(cell, static) if r.kind == "ssm-speed"]
+    (sp,) = static.speeds
+    assert f"max_speed: {math.ceil(sp.real * 100.0 - 1e-9) / 100.0}" in r.text
+    assert "ssm-speed" not in _check(r, tmp_path).failing

@@ -88,21 +88,39 @@ def test_bad_input_is_one_error_line(args, tmp_path, capsys):
 
 
 def test_a_row_no_candidate_answers_exits_1(tmp_path, capsys):
+    """The baseline's second waypoint with the shoulder lifted to -10 deg: the program sweeps the arm through
+    the table (its own check fails) and no candidate kind changes a program's path (docs/fix.md): exit 1, no
+    proposal, the JUnit verdict case fails."""
+    text = Path(builtin_file("baseline")).read_text()
+    old = "[37.1, -44.8, 78.4, -123.6, -90.0, 0.0]"
+    assert text.count(old) == 1
+    cell = tmp_path / "through-table.yaml"
+    cell.write_text(text.replace(old, "[37.1, -10.0, 78.4, -123.6, -90.0, 0.0]"))
+    out = tmp_path / "out"
+    assert main(["fix", str(cell), "--out", str(out), *ARGS, "--junit", str(tmp_path / "j.xml")]) == 1
+    doc = json.loads((out / "fix.json").read_text())
+    assert doc["failing_before"] == ["program"] and doc["candidates"] == []
+    assert not doc["needs_nothing"] and not list(out.glob("proposal-*.yaml"))
+    root = validate_junit((tmp_path / "j.xml").read_bytes())
+    assert [c.get("name") for c in root.iter("testcase")] == ["fix"] and len(list(root.iter("failure"))) == 1
+    assert "NO PROPOSAL WORKS" in capsys.readouterr().out
+
+
+def test_a_scanner_too_coarse_for_its_plane_gets_a_finer_resolution(tmp_path):
     """The baseline's scanner given a 150 mm resolution: ISO 13855 6.3 wants its plane at least 15 (150 - 50) =
-    1500 mm high and at most 300 mm: no height meets both, and no candidate kind changes a resolution
-    (docs/fix.md): exit 1, no proposal, the JUnit verdict case fails."""
+    1500 mm high and at most 300 mm, so no height works (device-height proposes none); the resolution
+    candidate sets 70 mm, and the re-test keeps it."""
     text = Path(builtin_file("baseline")).read_text()
     assert text.count("    height: 0.3\n") == 1
     cell = tmp_path / "coarse.yaml"
     cell.write_text(text.replace("    height: 0.3\n", "    height: 0.3\n    resolution_mm: 150\n"))
     out = tmp_path / "out"
-    assert main(["fix", str(cell), "--out", str(out), *ARGS, "--junit", str(tmp_path / "j.xml")]) == 1
+    assert main(["fix", str(cell), "--out", str(out), *ARGS]) == 0
     doc = json.loads((out / "fix.json").read_text())
-    assert doc["failing_before"] == ["front-scanner-mounting"] and doc["candidates"] == []
-    assert not doc["needs_nothing"] and not list(out.glob("proposal-*.yaml"))
-    root = validate_junit((tmp_path / "j.xml").read_bytes())
-    assert [c.get("name") for c in root.iter("testcase")] == ["fix"] and len(list(root.iter("failure"))) == 1
-    assert "NO PROPOSAL WORKS" in capsys.readouterr().out
+    assert doc["failing_before"] == ["front-scanner-mounting"]
+    (c,) = doc["candidates"]
+    assert c["kind"] == "scanner-resolution" and c["kept"] and "from 150 to 70 mm" in c["change"]
+    assert main(["check", str(out / "proposal-1.yaml")]) == 0
 
 
 def test_a_curtain_a_body_crawls_under_gets_its_beam_lowered(tmp_path):

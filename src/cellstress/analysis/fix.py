@@ -10,10 +10,11 @@ A candidate is **kept** when the changed cell passes ``check`` (every row) and i
 
 Cost, the ranking (cheapest first, docs/fix.md): cycle time added [s], then floor area added [m^2] (the cell's
 footprint: the convex hull of its fences and devices), then parts added, then the order the candidates were
-tried in (settings named by rows; ``analysis.way_remedies``' device heights, closed gaps, raised curtain tops
-and lowered panels; the device moved alone; the device moved with the cell; the program slowed per move:
-``analysis.safe_speed``, also where check passes and the re-test finds a hazard). A move
-that passes check while its re-test still finds a hazard is tried again ``EXTRA`` metres further. Wall-clock
+tried in (settings named by rows; ``analysis.way_remedies``' device heights, ``analysis.device_remedies``'
+scanner resolutions, closed gaps and gaps covered by a curtain, raised curtain tops and fences, enlarged warning
+fields, reduced speeds, deeper mats, lowered panels; the device moved alone; the device moved with the cell;
+the program slowed per move: ``analysis.safe_speed``, also where check passes and the re-test finds a hazard).
+A move that passes check while its re-test still finds a hazard is tried again ``EXTRA`` metres further. Wall-clock
 time is kept out of every file: the same inputs give the same bytes, unless a verify ends within a hair of
 the time limit on one run and not on another.
 """
@@ -27,6 +28,13 @@ from pathlib import Path
 import numpy as np
 
 from cellstress.analysis.check_rows import CheckRow, check_rows
+from cellstress.analysis.device_remedies import (
+    covered_gaps,
+    deeper_mats,
+    enlarged_warnings,
+    finer_resolutions,
+    reduced_speeds,
+)
 from cellstress.analysis.espe_rules import CurtainReachOver
 from cellstress.analysis.iso13855 import StaticCheck, check_cell
 from cellstress.analysis.program_check import check_programs
@@ -256,9 +264,12 @@ def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit
         return _static_of(text, scratch)
 
     if base.failing:
-        for r in setting_remedies(cell, static) + device_heights(cell, static) + closed_gaps(cell, static):
+        for r in (setting_remedies(cell, static) + device_heights(cell, static) + finer_resolutions(cell, static)
+                  + closed_gaps(cell, static) + covered_gaps(cell, static)):
             evaluate(r)
-        for r in raised_tops(cell, static, static_of) + raised_fences(cell, static, static_of):
+        for r in (raised_tops(cell, static, static_of) + raised_fences(cell, static, static_of)
+                  + enlarged_warnings(cell, static, static_of) + reduced_speeds(cell, static, static_of)
+                  + deeper_mats(cell, static)):
             evaluate(r)
         for tries in lowered_panels(cell, static):  # the least lowering first; a lower one only where it fails
             for r in tries:

@@ -13,7 +13,8 @@ looks at the cell's name: the built-in flawed cells and their fixed twins are th
 * **settings** named by a failing row: ``guard_locking: true`` on a guard door whose ISO 13855 row fails,
   ``restart: manual`` for a ``DEVICE-restart`` row, the muting's ``until`` set to the pallet's end for a
   ``DEVICE-muting`` row, a speed and separation controller's configured times set to the real ones its row
-  names as underestimated, and a device wired to a robot whose ``undetected-reach:ROBOT`` row fails.
+  names as underestimated and its configured top speed to the robot's real one (``DEVICE-speed``), and a
+  device wired to a robot whose ``undetected-reach:ROBOT`` row fails.
 * **slow-per-move**: the program's speed scales, one per move (``with_scales``; ``analysis.safe_speed`` finds them).
 """
 
@@ -41,12 +42,13 @@ ROUNDS = 4  # a move is re-measured and repeated at most this often (an oblique 
 class Remedy:
     """One candidate change: what it is (in words), which check rows it answers, and the whole changed cell."""
 
-    kind: str  # 'move-device', 'move-cell', 'guard-locking', 'manual-restart', 'muting-end', 'ssm-times',
-    # 'wire', 'slow-per-move', and analysis.way_remedies' 'lower-panel', 'close-gap', 'raise-top', 'raise-fence',
-    # 'device-height'
+    kind: str  # 'move-device', 'move-cell', 'guard-locking', 'manual-restart', 'muting-end', 'ssm-times', 'ssm-speed',
+    # 'wire', 'slow-per-move', analysis.way_remedies' 'lower-panel', 'close-gap', 'raise-top', 'raise-fence',
+    # 'device-height', and analysis.device_remedies' 'warning-field', 'reduced-speed', 'scanner-resolution',
+    # 'mat-depth', 'cover-gap'
     change: str  # e.g. "move front-mat's edge (-1.5, 2.3)-(1.5, 2.3) 0.47 m outward (+y)"
     rows: tuple[str, ...]  # the failing check rows (or 'hazard') it answers
-    parts_added: int  # new devices or fences (every remedy here adds none; the field keeps the cost honest)
+    parts_added: int  # new devices or fences ('close-gap' and 'cover-gap' add one; the others none)
     text: str  # the changed cell file (YAML)
 
 
@@ -161,7 +163,8 @@ def _nearest_entry(d: DeviceCheck):
     return None
 
 
-def _shift(p, m: Move):
+def shift_point(p, m: Move):
+    """Point p moved by the move where it lies on or beyond the edge's line, else as it is."""
     x, y = float(p[0]), float(p[1])
     if m.normal[0] * x + m.normal[1] * y >= m.line - ON_LINE:
         return [round(x + m.delta * m.normal[0], 6) + 0.0, round(y + m.delta * m.normal[1], 6) + 0.0]
@@ -171,12 +174,12 @@ def _shift(p, m: Move):
 def _shift_device(dev: dict, m: Move, warning: bool) -> None:
     for key in ("start", "end"):
         if isinstance(dev.get(key), list):
-            dev[key] = _shift(dev[key], m)
+            dev[key] = shift_point(dev[key], m)
     if isinstance(dev.get("polygon"), list):
-        dev["polygon"] = [_shift(p, m) for p in dev["polygon"]]
+        dev["polygon"] = [shift_point(p, m) for p in dev["polygon"]]
     warn = dev.get("warning")
     if warning and isinstance(warn, dict) and isinstance(warn.get("polygon"), list):
-        warn["polygon"] = [_shift(p, m) for p in warn["polygon"]]
+        warn["polygon"] = [shift_point(p, m) for p in warn["polygon"]]
 
 
 def _is_panel(m: Move) -> bool:
@@ -197,11 +200,16 @@ def apply_move(doc: dict, m: Move, whole: bool) -> None:
             _shift_device(dev, m, warning=True)
         for fence in doc.get("fences") or ():
             if isinstance(fence, dict) and isinstance(fence.get("points"), list):
-                fence["points"] = [_shift(p, m) for p in fence["points"]]
+                fence["points"] = [shift_point(p, m) for p in fence["points"]]
+    move_starts_and_floor(doc, m)
+
+
+def move_starts_and_floor(doc: dict, m: Move) -> None:
+    """The worker's start points beyond the move's line moved with it, and the floor grown by it (in place)."""
     human = doc.get("human") or {}
     for start in [human.get("start"), *(human.get("starts") or ())]:
         if isinstance(start, dict) and isinstance(start.get("xy"), list):
-            start["xy"] = _shift(start["xy"], m)
+            start["xy"] = shift_point(start["xy"], m)
     floor = doc.get("floor")
     if isinstance(floor, dict):
         for axis, (lo, hi) in ((0, ("xmin", "xmax")), (1, ("ymin", "ymax"))):
@@ -243,6 +251,13 @@ def setting_remedies(cell: Cell, static: StaticCheck) -> list[Remedy]:
                 words = ", ".join(f"{k} {v:g} s" for k, v in times.items())
                 out.append(_setting(base, d.device, "ssm-times", times, (d.device,),
                                     f"configure {d.device}'s controller with the real times ({words})"))
+    for sp in static.speeds:  # a monitor set for a slower robot: its configured top speed set to the real one
+        dev = device_entry(base, sp.device)
+        if not sp.ok and dev is not None and dev.get("type") == "speed-separation":
+            real = math.ceil(sp.real * 100.0 - 1e-9) / 100.0
+            out.append(_setting(base, sp.device, "ssm-speed", {"max_speed": real}, (f"{sp.device}-speed",),
+                                f"configure {sp.device} for the robot's real top speed ({real:g} m/s, was "
+                                f"{sp.configured:g})"))
     for r in static.restarts:
         if not r.ok and device_entry(base, r.device) is not None:
             out.append(_setting(base, r.device, "manual-restart", {"restart": "manual"}, (f"{r.device}-restart",),
