@@ -33,8 +33,8 @@ def _variant(cell, old, new, tmp_path):
     return _cell_of(text.replace(old, new), tmp_path, f"{cell}-variant.yaml")
 
 
-def _static_fn(tmp_path):
-    return lambda text: _static_of(text, tmp_path / "scratch.yaml")
+def _static_fn(cell, tmp_path):
+    return lambda text: _static_of(cell, text, tmp_path / "scratch.yaml")
 
 
 def _scanner(text):
@@ -50,7 +50,7 @@ def test_a_short_warning_field_is_grown_until_its_row_passes(tmp_path):
     cell = _variant("warning-field-ok", WARNING_FRONT, "polygon: [[-1.5, 3.3], [1.5, 3.3]", tmp_path)
     before, static = checked(cell)
     assert before.failing == ("front-scanner:warning",)
-    (r,) = enlarged_warnings(cell, static, _static_fn(tmp_path))
+    (r,) = enlarged_warnings(cell, static, _static_fn(cell, tmp_path))
     assert r.kind == "warning-field" and r.parts_added == 0 and r.rows == ("front-scanner:warning",)
     after = _scanner(r.text)
     assert after["polygon"] == _scanner(Path(cell.source).read_text())["polygon"]
@@ -65,7 +65,7 @@ def test_a_protective_field_a_little_short_gets_a_lower_reduced_speed(tmp_path):
                     tmp_path)
     before, static = checked(cell)
     assert before.failing == ("front-scanner",)
-    (r,) = reduced_speeds(cell, static, _static_fn(tmp_path))
+    (r,) = reduced_speeds(cell, static, _static_fn(cell, tmp_path))
     speed = _scanner(r.text)["warning"]["reduced_speed"]
     assert r.kind == "reduced-speed" and 0.0 < speed < 0.25
     assert checked(_cell_of(r.text, tmp_path))[0].failing == ()
@@ -84,7 +84,7 @@ def test_a_scanner_without_a_warning_field_gets_a_reduced_speed_zone(tmp_path):
     cell = _cell_of(text, tmp_path, "short.yaml")
     before, static = checked(cell)
     assert "front-scanner" in before.failing
-    (r,) = reduced_speeds(cell, static, _static_fn(tmp_path))
+    (r,) = reduced_speeds(cell, static, _static_fn(cell, tmp_path))
     warning = _scanner(r.text)["warning"]
     assert r.kind == "reduced-speed" and "reduced-speed zone" in r.change and 0.0 < warning["reduced_speed"] < 1.0
     assert checked(_cell_of(r.text, tmp_path))[0].failing == ()
@@ -153,7 +153,7 @@ def test_a_warning_field_that_lets_the_robot_run_too_fast_gets_a_lower_reduced_s
                     "      reduced_speed: 0.25\n      speed_limit: 0.2\n", tmp_path)
     before, static = checked(cell)
     assert before.failing == ("front-scanner:warning-speed",)
-    (r,) = reduced_speeds(cell, static, _static_fn(tmp_path))
+    (r,) = reduced_speeds(cell, static, _static_fn(cell, tmp_path))
     assert r.rows == ("front-scanner:warning-speed",)
     speed = _scanner(r.text)["warning"]["reduced_speed"]
     assert 0.0 < speed < 0.25

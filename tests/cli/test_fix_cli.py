@@ -138,3 +138,24 @@ def test_a_curtain_a_body_crawls_under_gets_its_beam_lowered(tmp_path):
     assert c["kind"] == "device-height" and c["kept"] and c["answers"] == ["bay-curtain-crawl-under"]
     assert "from 600 to 300 mm" in c["change"]
     assert main(["check", str(out / "proposal-1.yaml")]) == 0
+
+
+def test_with_files_confined_a_cell_reading_its_own_robot_is_fixed(tmp_path, monkeypatch):
+    """long-gripper (its robot a URDF file beside it) copied with that file into a folder of its own, under
+    CELLSTRESS_FILES=inside: the candidates keep the file's relative name and are read as if beside the
+    original (a copy in --out may read only that folder), so a proposal is kept; put beside the original,
+    it passes check in the same strict mode."""
+    monkeypatch.setenv("CELLSTRESS_FILES", "inside")
+    cell_dir = tmp_path / "cell"
+    cell_dir.mkdir()
+    for name in ("long-gripper.yaml", "boxarm.urdf"):
+        (cell_dir / name).write_bytes(Path(builtin_file("long-gripper")).with_name(name).read_bytes())
+    out = tmp_path / "out"
+    assert main(["fix", str(cell_dir / "long-gripper.yaml"), "--out", str(out), *ARGS]) == 0
+    doc = json.loads((out / "fix.json").read_text())
+    kept = [c for c in doc["candidates"] if c["kept"]]
+    assert kept and not any("outside" in f for c in doc["candidates"] for f in c["failing_after"])
+    text = (out / "proposal-1.yaml").read_text()
+    assert "urdf: boxarm.urdf" in text
+    (cell_dir / "proposal-1.yaml").write_text(text)
+    assert main(["check", str(cell_dir / "proposal-1.yaml")]) == 0

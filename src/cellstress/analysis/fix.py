@@ -45,6 +45,7 @@ from cellstress.analysis.remedies import (
     device_move,
     moved,
     panel_move,
+    parse_candidate,
     reach_over_move,
     setting_remedies,
 )
@@ -56,9 +57,8 @@ from cellstress.analysis.way_remedies import (
     raised_fences,
     raised_tops,
 )
-from cellstress.cell.load import Cell, parse_cell
+from cellstress.cell.load import Cell
 from cellstress.core.errors import CellstressError
-from cellstress.core.io import atomic_write_text
 from cellstress.robot.capsules import convex_hull_2d
 from cellstress.searchers import search
 from cellstress.sim.build import build_layout
@@ -200,10 +200,6 @@ def retest(cell: Cell, budget: int, seed: int, time_limit: float) -> Retest:
 
 
 # ---- the candidates ----------------------------------------------------------------------------------------
-def _parse(remedy: Remedy, path: Path) -> Cell:
-    """The candidate written to ``path`` and read back as any cell file is."""
-    atomic_write_text(path, remedy.text)
-    return parse_cell(remedy.text, str(path), path.resolve().parent)
 
 
 def _moves(cell: Cell, static: StaticCheck, whole: bool, scratch: Path) -> tuple[Move, ...]:
@@ -220,7 +216,7 @@ def _moves(cell: Cell, static: StaticCheck, whole: bool, scratch: Path) -> tuple
             break
         moves += new
         try:
-            c = _parse(moved(cell, tuple(moves), whole), scratch)
+            c = parse_candidate(cell, moved(cell, tuple(moves), whole).text, scratch)
         except CellstressError:
             break  # the candidate's own evaluation reports it
         current = checked(c)[1]
@@ -257,11 +253,11 @@ def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit
     proposals: list[Proposal] = []
 
     def evaluate(r: Remedy) -> Proposal:
-        proposals.append(_evaluate(len(proposals) + 1, r, base, out, budget, seed, time_limit))
+        proposals.append(_evaluate(cell, len(proposals) + 1, r, base, out, budget, seed, time_limit))
         return proposals[-1]
 
     def static_of(text: str) -> StaticCheck | None:
-        return _static_of(text, scratch)
+        return _static_of(cell, text, scratch)
 
     if base.failing:
         for r in (setting_remedies(cell, static) + device_heights(cell, static) + finer_resolutions(cell, static)
@@ -294,20 +290,20 @@ def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit
     return replace(result, candidates=tuple(proposals))
 
 
-def _static_of(text: str, scratch: Path) -> StaticCheck | None:
-    """The static check of the cell file ``text`` (written to ``scratch`` and read back), None if invalid."""
+def _static_of(cell: Cell, text: str, scratch: Path) -> StaticCheck | None:
+    """The static check of the changed copy ``text`` of ``cell`` (``parse_candidate``), None if invalid."""
     try:
-        c = _parse(Remedy("", "", (), 0, text), scratch)
+        c = parse_candidate(cell, text, scratch)
     except CellstressError:
         return None
     return checked(c)[1]
 
 
-def _evaluate(number: int, r: Remedy, base: Checked, out: Path, budget: int, seed: int, time_limit: float) \
-        -> Proposal:
+def _evaluate(cell: Cell, number: int, r: Remedy, base: Checked, out: Path, budget: int, seed: int,
+              time_limit: float) -> Proposal:
     path = out / f"candidate-{number}.yaml"
     try:
-        c = _parse(r, path)
+        c = parse_candidate(cell, r.text, path)
     except CellstressError as exc:
         return Proposal(number, r.kind, r.change, r.rows, 0.0, 0.0, r.parts_added, (f"invalid: {exc}",), None,
                         False, r.text)

@@ -30,8 +30,9 @@ import yaml
 
 from cellstress.analysis.espe_rules import CurtainReachOver
 from cellstress.analysis.iso13855 import DeviceCheck, StaticCheck
-from cellstress.cell.load import Cell, builtin_text, safe_load_yaml
-from cellstress.core.io import read_input_bytes
+from cellstress.cell.files import confined
+from cellstress.cell.load import Cell, builtin_text, parse_cell, safe_load_yaml
+from cellstress.core.io import atomic_write_text, read_input_bytes
 
 MARGIN = 0.05  # m added to an ISO 13855 shortfall: the check's own distances are rounded to the mm
 ON_LINE = 1e-6  # m: a point this close to the moved edge's line counts as on it
@@ -56,7 +57,8 @@ class Remedy:
 def cell_document(cell: Cell) -> dict:
     """The cell file's YAML mapping as written (built-in or file), with every file it reads made absolute, so a
     changed copy written elsewhere reads the same robot, trajectory and stopping data, and with the criterion
-    ``cell`` is judged by."""
+    ``cell`` is judged by. With ``CELLSTRESS_FILES=inside`` the names stay as written: a copy may read only
+    files in the original's folder, so it is read as if it lay there (``parse_candidate``)."""
     if cell.directory is None:
         text = builtin_text(cell.source)
     else:
@@ -64,7 +66,7 @@ def cell_document(cell: Cell) -> dict:
     doc = safe_load_yaml(text)
     # the criterion the cell is judged by here (``--criterion`` may differ from the file's), written out whole
     doc["criterion"] = cell.spec.criterion.model_dump(mode="json")
-    base = cell.files_dir
+    base = None if confined() else cell.files_dir
     for robot in _robots(doc):
         _absolute(robot, "urdf", base)
         _absolute(robot.get("task") or {}, "trajectory_csv", base)
@@ -78,6 +80,15 @@ def _absolute(where: dict, key: str, base: Path | None) -> None:
         path = base / value
         if path.is_file():  # a URDF may also be a short name ('ur5'), which is no file
             where[key] = os.path.realpath(path)
+
+
+def parse_candidate(cell: Cell, text: str, path: Path) -> Cell:
+    """A changed copy of ``cell`` written to ``path`` and read back as any cell file is: its relative file names
+    resolve beside it, or, with ``CELLSTRESS_FILES=inside``, beside the original (whose folder the copy's
+    files must lie in; the copy is to be put there to be used)."""
+    atomic_write_text(path, text)
+    home = cell.files_dir if confined() and cell.directory is not None else path.resolve().parent
+    return parse_cell(text, str(path), home)
 
 
 def _robots(doc: dict) -> list[dict]:

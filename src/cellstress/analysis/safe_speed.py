@@ -26,10 +26,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from cellstress.analysis.program_check import check_programs
-from cellstress.analysis.remedies import Remedy, program_moves, with_scales
-from cellstress.cell.load import Cell, parse_cell
+from cellstress.analysis.remedies import Remedy, parse_candidate, program_moves, with_scales
+from cellstress.cell.load import Cell
 from cellstress.core.errors import CellstressError
-from cellstress.core.io import atomic_write_text
 from cellstress.searchers import search
 from cellstress.sim.build import build_layout
 from cellstress.sim.simulator import Simulator
@@ -74,8 +73,7 @@ def _scaled_cell(cell: Cell, scales: dict[tuple[int, int], float], words: str, s
     arrives where the robot is in the cell as given (with the phase fixed in seconds, a faster or slower
     program would put the robot elsewhere at arrival, and speed would change what the search meets)."""
     first = with_scales(cell, scales, words)
-    atomic_write_text(scratch, first.text)
-    c = parse_cell(first.text, str(scratch), scratch.resolve().parent)
+    c = parse_candidate(cell, first.text, scratch)
     old, new = timings(cell), timings(c)
     phases = {k: map_phase(float(r.task.phase), old[k], new[k]) for k, r in enumerate(cell.spec.robots)
               if k < len(old) and not r.task.trajectory_csv}
@@ -85,8 +83,7 @@ def _scaled_cell(cell: Cell, scales: dict[tuple[int, int], float], words: str, s
 def _safe(cell: Cell, scales: dict[tuple[int, int], float], budget: int, seed: int, scratch: Path) -> bool:
     try:
         remedy = _scaled_cell(cell, scales, "", scratch)
-        atomic_write_text(scratch, remedy.text)
-        c = parse_cell(remedy.text, str(scratch), scratch.resolve().parent)
+        c = parse_candidate(cell, remedy.text, scratch)
     except CellstressError:  # e.g. a joint over its velocity limit at this scale
         return False
     return not search(Simulator(c), SEARCHER, budget, seed, until="budget", distinct=True).distinct
