@@ -16,7 +16,7 @@ from cellstress.analysis.device_remedies import (
     finer_resolutions,
     reduced_speeds,
 )
-from cellstress.analysis.fix import _static_of, checked
+from cellstress.analysis.fix import _moves, _static_of, checked
 from cellstress.cell.load import builtin_file, load_cell, parse_cell
 from cellstress.core.iso13855 import MAT_MIN_DEPTH_MM, min_scan_height_mm
 
@@ -160,3 +160,13 @@ def test_a_warning_field_that_lets_the_robot_run_too_fast_gets_a_lower_reduced_s
     assert checked(_cell_of(r.text, tmp_path))[0].failing == ()
     above = r.text.replace(f"reduced_speed: {speed}", f"reduced_speed: {round(speed + SPEED_STEP, 6)}")
     assert "front-scanner:warning-speed" in checked(_cell_of(above, tmp_path, "above.yaml"))[0].failing
+
+
+def test_a_warning_row_gets_no_move_of_the_device_alone(tmp_path):
+    """The warning row names no device of the file: moving 'the device alone' would move nothing (it once gave
+    a candidate that repeated the same empty move four times); the move with the cell still stretches it."""
+    cell = _variant("warning-field-ok", WARNING_FRONT, "polygon: [[-1.5, 3.3], [1.5, 3.3]", tmp_path)
+    _, static = checked(cell)
+    assert _moves(cell, static, False, tmp_path / "scratch.yaml") == ()
+    (m,) = _moves(cell, static, True, tmp_path / "scratch.yaml")
+    assert m.device == "front-scanner:warning" and m.delta > 0.0

@@ -42,6 +42,8 @@ from cellstress.analysis.remedies import (
     ROUNDS,
     Move,
     Remedy,
+    cell_document,
+    device_entry,
     device_move,
     moved,
     panel_move,
@@ -207,8 +209,11 @@ def _moves(cell: Cell, static: StaticCheck, whole: bool, scratch: Path) -> tuple
     device row pass, or the last tried."""
     moves: list[Move] = []
     current = static
+    doc = cell_document(cell)
     for _ in range(ROUNDS):
         new = _device_moves(current)
+        if not whole:  # a row that names no device of the file (a warning field's) cannot move alone
+            new = [m for m in new if device_entry(doc, m.device) is not None]
         if whole:  # a fence panel too close for ISO 13857 Table 2 moves with the walls that meet it
             panels = [pr for a in (current.approach, *current.robot_approaches) for pr in a.reach_over_fails]
             new += list({m.line: m for pr in panels if (m := panel_move(pr)) is not None}.values())
