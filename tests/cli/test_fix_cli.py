@@ -159,3 +159,26 @@ def test_with_files_confined_a_cell_reading_its_own_robot_is_fixed(tmp_path, mon
     assert "urdf: boxarm.urdf" in text
     (cell_dir / "proposal-1.yaml").write_text(text)
     assert main(["check", str(cell_dir / "proposal-1.yaml")]) == 0
+
+
+def test_two_rows_no_single_change_answers_get_a_pair(tmp_path):
+    """The baseline with its bay curtain's lowest beam at 0.6 m and its scanner at a 150 mm resolution: each
+    candidate answers one of the two rows and leaves the other failing, so none works alone; the pair (the
+    beam lowered, then the resolution set) is one candidate, kept, with both changes in its file."""
+    text = Path(builtin_file("baseline")).read_text()
+    assert text.count("    bottom: 0.2") == 1 and text.count("    height: 0.3\n") == 1
+    cell = tmp_path / "two-rows.yaml"
+    cell.write_text(text.replace("    bottom: 0.2", "    bottom: 0.6").replace(
+        "    height: 0.3\n", "    height: 0.3\n    resolution_mm: 150\n"))
+    out = tmp_path / "out"
+    assert main(["fix", str(cell), "--out", str(out), *ARGS]) == 0
+    doc = json.loads((out / "fix.json").read_text())
+    assert doc["failing_before"] == ["front-scanner-mounting", "bay-curtain-crawl-under"]
+    singles = [c for c in doc["candidates"] if "+" not in c["kind"]]
+    assert singles and not any(c["kept"] for c in singles)
+    (pair,) = [c for c in doc["candidates"] if c["kept"]]
+    assert pair["kind"] == "device-height+scanner-resolution"
+    assert set(pair["answers"]) == {"front-scanner-mounting", "bay-curtain-crawl-under"}
+    proposal = (out / "proposal-1.yaml").read_text()
+    assert "bottom: 0.3" in proposal and "resolution_mm: 70" in proposal
+    assert main(["check", str(out / "proposal-1.yaml")]) == 0

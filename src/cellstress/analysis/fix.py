@@ -70,6 +70,7 @@ from cellstress.verifier.run import VerifyError, verify_cell
 MAX_VERIFY_HORIZON = 12  # verify's own limit
 SEARCHER = "plan"
 EXTRA = (0.1, 0.2, 0.4)  # m beyond ISO 13855 tried in turn where a move passes check and the re-test finds a hazard
+SECOND_STEPS = 3  # first changes a second one is tried on, where no single change works
 
 
 @dataclass(frozen=True)
@@ -261,29 +262,9 @@ def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit
         proposals.append(_evaluate(cell, len(proposals) + 1, r, base, out, budget, seed, time_limit))
         return proposals[-1]
 
-    def static_of(text: str) -> StaticCheck | None:
-        return _static_of(cell, text, scratch)
-
     if base.failing:
-        for r in (setting_remedies(cell, static) + device_heights(cell, static) + finer_resolutions(cell, static)
-                  + closed_gaps(cell, static) + covered_gaps(cell, static)):
-            evaluate(r)
-        for r in (raised_tops(cell, static, static_of) + raised_fences(cell, static, static_of)
-                  + enlarged_warnings(cell, static, static_of) + reduced_speeds(cell, static, static_of)
-                  + deeper_mats(cell, static)):
-            evaluate(r)
-        for tries in lowered_panels(cell, static):  # the least lowering first; a lower one only where it fails
-            for r in tries:
-                if evaluate(r).kept:
-                    break
-        for whole in (False, True):
-            moves = _moves(cell, static, whole, scratch)
-            for extra in (0.0, *EXTRA):
-                if not moves:
-                    break
-                p = evaluate(moved(cell, moves, whole, extra))
-                if p.failing_after or p.kept:  # more room helps only where check passes and a hazard remains
-                    break
+        _try_every_kind(cell, static, evaluate, scratch)
+        _second_steps(cell, base, proposals, evaluate, out, scratch)
     elif not speeds:  # check passes and the re-test found a hazard: slowing is the remedy left
         speeds = move_speeds(cell, budget, seed, scratch)
         result = replace(result, speeds=speeds)
@@ -293,6 +274,61 @@ def fix_cell(cell: Cell, out: Path, budget: int = 100, seed: int = 0, time_limit
     if scratch.exists():
         scratch.unlink()
     return replace(result, candidates=tuple(proposals))
+
+
+def _try_every_kind(cell: Cell, static: StaticCheck, evaluate, scratch: Path) -> None:
+    """Every candidate kind for ``cell``'s failing rows, in the order tried (module docstring), each handed to
+    ``evaluate`` (which checks, re-tests and records it, and returns its ``Proposal``)."""
+
+    def static_of(text: str) -> StaticCheck | None:
+        return _static_of(cell, text, scratch)
+
+    for r in (setting_remedies(cell, static) + device_heights(cell, static) + finer_resolutions(cell, static)
+              + closed_gaps(cell, static) + covered_gaps(cell, static)):
+        evaluate(r)
+    for r in (raised_tops(cell, static, static_of) + raised_fences(cell, static, static_of)
+              + enlarged_warnings(cell, static, static_of) + reduced_speeds(cell, static, static_of)
+              + deeper_mats(cell, static)):
+        evaluate(r)
+    for tries in lowered_panels(cell, static):  # the least lowering first; a lower one only where it fails
+        for r in tries:
+            if evaluate(r).kept:
+                break
+    for whole in (False, True):
+        moves = _moves(cell, static, whole, scratch)
+        for extra in (0.0, *EXTRA):
+            if not moves:
+                break
+            p = evaluate(moved(cell, moves, whole, extra))
+            if p.failing_after or p.kept:  # more room helps only where check passes and a hazard remains
+                break
+
+
+def _second_steps(cell: Cell, base: Checked, proposals: list[Proposal], evaluate, out: Path, scratch: Path) -> None:
+    """Where no candidate works, a candidate that leaves fewer failing rows (and no new one) is taken as the
+    cell and every kind is tried on it again, the two changes as one candidate (its cost against the cell as
+    given): one row answered by each, as a closed gap and a moved scanner. At most ``SECOND_STEPS`` first
+    changes, fewest rows left first; it stops at the first that gives a working pair."""
+    if any(p.kept for p in proposals):
+        return
+    before = set(base.failing)
+    firsts = sorted((p for p in proposals if p.retest is None and p.failing_after
+                     and set(p.failing_after) < before), key=lambda p: (len(p.failing_after), p.number))
+    for first in firsts[:SECOND_STEPS]:
+        try:  # read from its own file: every generator reads the cell's file again, and the scratch one changes
+            c = parse_candidate(cell, first.text, out / f"candidate-{first.number}.yaml")
+        except CellstressError:
+            continue
+        _, static = checked(c)
+
+        def then(r: Remedy, first: Proposal = first) -> Proposal:
+            return evaluate(Remedy(f"{first.kind}+{r.kind}", f"{first.change}; then {r.change}",
+                                   tuple(dict.fromkeys(first.answers + r.rows)), first.parts_added + r.parts_added,
+                                   r.text))
+
+        _try_every_kind(c, static, then, scratch)
+        if any(p.kept for p in proposals):
+            return
 
 
 def _static_of(cell: Cell, text: str, scratch: Path) -> StaticCheck | None:
