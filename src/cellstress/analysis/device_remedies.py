@@ -36,7 +36,6 @@ from collections.abc import Callable
 from cellstress.analysis.espe_rules import MatDepth, ScannerMounting
 from cellstress.analysis.iso13855 import DeviceCheck, StaticCheck
 from cellstress.analysis.remedies import (
-    MARGIN,
     ROUNDS,
     Move,
     Remedy,
@@ -45,6 +44,7 @@ from cellstress.analysis.remedies import (
     device_move,
     dump_cell,
     move_starts_and_floor,
+    past_shortfall,
     shift_point,
 )
 from cellstress.cell.load import Cell
@@ -209,7 +209,7 @@ def deeper_mats(cell: Cell, static: StaticCheck) -> list[Remedy]:
         if length < 1e-9 or dev is None or not isinstance(dev.get("polygon"), list):
             continue
         n = (round((px - qx) / length, 12) + 0.0, round((py - qy) / length, 12) + 0.0)
-        delta = math.ceil((I.MAT_MIN_DEPTH_MM / 1000.0 - rule.depth + MARGIN) * 100.0 - 1e-9) / 100.0
+        delta = past_shortfall(I.MAT_MIN_DEPTH_MM / 1000.0 - rule.depth)
         m = Move(rule.device, ((px, py), (px, py)), n, n[0] * px + n[1] * py, delta)
         dev["polygon"] = [shift_point(p, m) for p in dev["polygon"]]
         move_starts_and_floor(doc, m)

@@ -120,6 +120,16 @@ class Move:
     delta: float
 
 
+def cm_up(x: float) -> float:
+    """``x`` [m] rounded up to the centimetre (a hair below a whole centimetre stays there)."""
+    return math.ceil(x * 100.0 - 1e-9) / 100.0
+
+
+def past_shortfall(shortfall: float) -> float:
+    """How far to move an edge short of a required distance by ``shortfall`` [m]: plus ``MARGIN``, cm up."""
+    return cm_up(shortfall + MARGIN)
+
+
 def device_move(d: DeviceCheck) -> Move | None:
     """How far and where to move device ``d``'s nearest entry so that its distance meets ISO 13855."""
     if d.ok or d.where is None or not math.isfinite(d.actual):
@@ -136,7 +146,7 @@ def device_move(d: DeviceCheck) -> Move | None:
     if n[0] * ((x0 + x1) / 2 - hx) + n[1] * ((y0 + y1) / 2 - hy) < 0:
         n = (-n[0], -n[1])
     n = (round(n[0], 12) + 0.0, round(n[1], 12) + 0.0)
-    delta = math.ceil((d.required - d.actual + MARGIN) * 100.0 - 1e-9) / 100.0
+    delta = past_shortfall(d.required - d.actual)
     return Move(d.device, edge, n, n[0] * x0 + n[1] * y0, delta)
 
 
@@ -148,7 +158,7 @@ def reach_over_move(r: CurtainReachOver, d: DeviceCheck) -> Move | None:
     m = device_move(replace(d, ok=False, actual=0.0, required=0.0))  # the edge and its outward normal only
     if m is None:
         return None
-    return replace(m, delta=math.ceil((r.required - r.behind + MARGIN) * 100.0 - 1e-9) / 100.0)
+    return replace(m, delta=past_shortfall(r.required - r.behind))
 
 
 def panel_move(pr) -> Move | None:
@@ -163,7 +173,7 @@ def panel_move(pr) -> Move | None:
         return None
     n = (reach.side * -(y1 - y0) / length, reach.side * (x1 - x0) / length)
     n = (round(n[0], 12) + 0.0, round(n[1], 12) + 0.0)
-    delta = math.ceil((reach.required - reach.behind + MARGIN) * 100.0 - 1e-9) / 100.0
+    delta = past_shortfall(reach.required - reach.behind)
     return Move(panel.name, ((x0, y0), (x1, y1)), n, n[0] * x0 + n[1] * y0, delta)
 
 
@@ -265,7 +275,7 @@ def setting_remedies(cell: Cell, static: StaticCheck) -> list[Remedy]:
     for sp in static.speeds:  # a monitor set for a slower robot: its configured top speed set to the real one
         dev = device_entry(base, sp.device)
         if not sp.ok and dev is not None and dev.get("type") == "speed-separation":
-            real = math.ceil(sp.real * 100.0 - 1e-9) / 100.0
+            real = cm_up(sp.real)
             out.append(_setting(base, sp.device, "ssm-speed", {"max_speed": real}, (f"{sp.device}-speed",),
                                 f"configure {sp.device} for the robot's real top speed ({real:g} m/s, was "
                                 f"{sp.configured:g})"))
