@@ -37,12 +37,12 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from iso13857_bound import attainable, body_2d  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-from cellstress.cell.load import parse_cell
+from cellstress.cell.load import parse_cell  # noqa: E402
 from cellstress.core.iso13857 import TABLE_1, TABLE_2, TABLE_4, opening_distance  # noqa: E402
 from cellstress.human.anthropometry import BODY_SIZES, TIPTOE_RISE  # noqa: E402
+from cellstress.human.reach_bound import attainable, body_bound  # noqa: E402
 from cellstress.sim.simulator import Simulator  # noqa: E402
 
 STEP_MM = 100.0  # one step of Table 2's c grid: the agreement tolerance
@@ -374,7 +374,7 @@ def print_reach_over(out, body, flexion, columns, rows, secs, played, args) -> N
           f"beam width {args.width} per height, depth {args.depth} actions, {args.spa} steps per action, "
           f"{played} sequences played, {secs:.1f} s")
     # the cells a body of this size can reach at all (benchmarks/iso13857_bound.py, its generous defaults)
-    bound = body_2d(body, 180.0, TIPTOE_RISE)
+    bound = body_bound(body, 180.0, TIPTOE_RISE)
     within = {"agree": 0, "short": 0, "beyond": 0}
     for a in rows:
         for b in columns:

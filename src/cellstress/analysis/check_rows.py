@@ -72,8 +72,10 @@ def check_rows(static, programs=()) -> tuple[CheckRow, ...]:
                              "of floor the worker stands on unseen"))
         if a.panels_at:
             fails = a.reach_over_fails
+            # the simulated worker takes this way in unless it can reach over none of the failing panels
+            limit = "; ".join(dict.fromkeys(p.limit for p in fails)) if all(p.limit for p in fails) else ""
             rows.append(CheckRow(_robot("reach-over", a.robot), "ISO 13857 Table 2 reach over a fence", not fails,
-                                 f"{len(fails)} of {len(a.panels_at)} panels too close", ""))
+                                 f"{len(fails)} of {len(a.panels_at)} panels too close", "", limit))
     for r in static.restarts:
         rows.append(CheckRow(f"{r.device}-restart", "automatic restart", r.ok,
                              f"{_m(r.behind.distance)} (needs {r.behind.arm_allowance:.3f} m)",

@@ -125,7 +125,8 @@ def _reach_over_lines(a, cycle: float) -> list[str]:
             "high risk" + (f"; {low} lower than 1.4 m, which 4.4 allows only with further protective measures"
                            if low else "") + "): ")
     if fails:
-        return [head + f"{len(fails)} too close"] + [_panel_row(p, cycle) for p in fails]
+        return [head + f"{len(fails)} too close"] + [line for p in fails for line in
+                                                     (_panel_row(p, cycle), *(["      " + p.limit] if p.limit else []))]
     tight = min(a.panels_at, key=lambda p: p.reach.behind - p.reach.required)
     if math.isinf(tight.reach.behind):
         return [head + "no part of the hazard zone lies within the table's distances behind any of them: ok"]

@@ -58,6 +58,7 @@ from cellstress.analysis.plane import (
 )
 from cellstress.analysis.reach_over import HazardVolume, ReachOver, hazard_volume, panels_at, reach_over
 from cellstress.analysis.stopping import speed_checks
+from cellstress.analysis.worker_reach import worker_limit
 from cellstress.cell.load import Cell, load_cell
 from cellstress.core.iso13857 import NO_BARRIER_BELOW_MM
 from cellstress.core.records import DoorLeaf, ScanPlane, VerticalField
@@ -124,6 +125,7 @@ class PanelReach:
 
     panel: FencePanel
     reach: ReachOver
+    limit: str = ""  # a failing panel the simulated worker cannot reach over: why (analysis.worker_reach)
 
 
 @dataclass(frozen=True)
@@ -360,9 +362,14 @@ def _approach_check(spec, layout, zone: HazardZone, vol: HazardVolume, panels, l
     at = panels_at(X[U], Y[U], [(p.start, p.end) for p in barriers], radius + h)
     return ApproachCheck((float(sx), float(sy)), bool(detected), float(U.sum() * h * h), lean, allowance,
                          m_scan, m_curtain, stand, float(best), where, bool(best >= allowance - 1e-9),
-                         panels_at=tuple(PanelReach(barriers[i], reach_over(barriers[i].start, barriers[i].end,
-                                                                            barriers[i].top, vol, side))
-                                         for i, side in at))
+                         panels_at=tuple(_panel_reach(spec, layout, barriers[i], vol, side) for i, side in at))
+
+
+def _panel_reach(spec, layout, panel: FencePanel, vol: HazardVolume, side: int) -> PanelReach:
+    """Table 2 at a panel the worker stands at, and, where it fails, whether the simulated worker can reach over."""
+    ro = reach_over(panel.start, panel.end, panel.top, vol, side)
+    limit = "" if ro.ok else worker_limit(spec.human, layout.params, panel.start, panel.end, panel.top, vol, side)
+    return PanelReach(panel, ro, limit)
 
 
 @dataclass(frozen=True)

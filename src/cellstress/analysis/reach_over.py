@@ -113,16 +113,28 @@ def reach_over(p0, p1, top: float, vol: HazardVolume, side: int = 0) -> ReachOve
     panel to the zone's part in the band against the band's c; returned for the band with the least margin
     (the first such band from the floor up on a tie). With ``side`` (the worker's side, as ``ReachOver.side``)
     only the zone on the other side counts, and what reaches within a ball's radius of the panel's line."""
-    b_mm = top * 1000.0
-    if b_mm < T.NO_BARRIER_BELOW_MM:
+    if top * 1000.0 < T.NO_BARRIER_BELOW_MM:
         return ReachOver(top, math.nan, math.inf, math.inf, (0.0, 0.0), side=side)
+    best: ReachOver | None = None
+    for row in band_rows(p0, p1, top, vol, side):
+        if best is None or row.behind - row.required < best.behind - best.required - 1e-12:
+            best = row
+    if best is None:  # a top at 2.7 m or higher: nothing behind it can be reached over it
+        return ReachOver(top, math.nan, math.inf, 0.0, (0.0, 0.0), side=side)
+    return best
+
+
+def band_rows(p0, p1, top: float, vol: HazardVolume, side: int = 0) -> list[ReachOver]:
+    """``reach_over``'s verdict in every row band of Table 2 that asks a distance behind a panel of this top, from
+    the floor up (the zone's nearest part in the band; ``behind`` inf where the zone has none in the band)."""
+    b_mm = top * 1000.0
     d = point_segment(vol.c[:, 0], vol.c[:, 1], p0[0], p0[1], p1[0], p1[1])[0]
     keep = d - vol.r < MAX_C + 1e-6  # farther balls meet every band's distance
     if side:
         keep &= side * _signed(p0, p1, vol.c[:, 0], vol.c[:, 1]) <= vol.r
     near = np.flatnonzero(keep)
     d, z, rad = d[near], vol.c[near, 2], vol.r[near]
-    best: ReachOver | None = None
+    rows = []
     for lo, hi, mid in BANDS:
         need = T.reach_over_distance(max(mid, 0.0) * 1000.0, b_mm) / 1000.0
         if need <= 0.0:
@@ -130,19 +142,15 @@ def reach_over(p0, p1, top: float, vol: HazardVolume, side: int = 0) -> ReachOve
         gap = np.maximum(np.maximum(lo - z, z - hi), 0.0)  # vertical distance of each centre from the band
         cut = gap < rad
         if not cut.any():
-            row = ReachOver(top, math.nan, math.inf, need, (max(lo, 0.0), hi), side=side)
-        else:
-            dist = d[cut] - np.sqrt(rad[cut] ** 2 - gap[cut] ** 2)
-            k = int(np.argmin(dist))
-            i = int(near[np.flatnonzero(cut)[k]])
-            row = ReachOver(top, float(min(max(vol.c[i, 2], lo, 0.0), hi)), max(float(dist[k]), 0.0), need,
-                            (max(lo, 0.0), hi), vol.part_names[int(vol.part[i])], round(float(vol.t[i]), 3),
-                            side)
-        if best is None or row.behind - row.required < best.behind - best.required - 1e-12:
-            best = row
-    if best is None:  # a top at 2.7 m or higher: nothing behind it can be reached over it
-        return ReachOver(top, math.nan, math.inf, 0.0, (0.0, 0.0), side=side)
-    return best
+            rows.append(ReachOver(top, math.nan, math.inf, need, (max(lo, 0.0), hi), side=side))
+            continue
+        dist = d[cut] - np.sqrt(rad[cut] ** 2 - gap[cut] ** 2)
+        k = int(np.argmin(dist))
+        i = int(near[np.flatnonzero(cut)[k]])
+        rows.append(ReachOver(top, float(min(max(vol.c[i, 2], lo, 0.0), hi)), max(float(dist[k]), 0.0), need,
+                              (max(lo, 0.0), hi), vol.part_names[int(vol.part[i])], round(float(vol.t[i]), 3),
+                              side))
+    return rows
 
 
 def panels_at(xs: np.ndarray, ys: np.ndarray, panels, reach: float) -> list[tuple[int, int]]:

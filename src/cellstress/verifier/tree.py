@@ -68,6 +68,8 @@ class TreeOutcome:
     hits: list[Hit] = field(default_factory=list)
     timed_out: bool = False
     layers: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)  # (sorted keys, states), if kept
+    seconds: list[float] = field(default_factory=list)  # wall time of each action's layer (benchmarks only: the
+    # verdict and verify.json never read it, so the same inputs still give the same bytes)
 
     @property
     def undecided(self) -> int:
@@ -143,6 +145,7 @@ def decide(sim, horizon: int, bounds: Bounds, *, deadline: float | None = None,
     exact = np.int64 if out.total < 2 ** 62 else object
     states, mult, prefixes = s0[None, :].copy(), np.ones(1, dtype=exact), np.zeros((1, 0), dtype=np.int8)
     for depth in range(1, horizon + 1):
+        t_layer = time.perf_counter()
         weight = n_act ** (horizon - depth)
         kept_states, kept_mult, kept_parent, kept_action = [], [], [], []
         for i0 in range(0, len(states), CHUNK):
@@ -184,10 +187,12 @@ def decide(sim, horizon: int, bounds: Bounds, *, deadline: float | None = None,
                 kept_action.append((idx % n_act).astype(np.int8))
             _tell(progress, out.hazardous + out.safe - before)
         if depth == horizon:
+            out.seconds.append(time.perf_counter() - t_layer)
             break
         states, mult, prefixes = _merge(np.concatenate(kept_states), np.concatenate(kept_mult),
                                         np.concatenate(kept_parent), np.concatenate(kept_action), prefixes)
         out.states.append(len(states))
+        out.seconds.append(time.perf_counter() - t_layer)
         if keep:
             keys = merge_keys(states)
             order = np.argsort(keys)

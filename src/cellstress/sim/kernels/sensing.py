@@ -150,12 +150,15 @@ def body_blocked(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr):
     for free. (Where its hands can get past a panel is limited separately, by fence_detour.) Its hanging arms
     are not held off obstacles: bent over a table they would hit its top, which its fixed arm pose cannot
     avoid; the reach volumes ignore obstacles likewise. The articulated worker's arms (upper arms, forearms,
-    hands) are held off obstacles as well: its arms do not pass through the table.
+    hands) are held off obstacles as well: its arms do not pass through the table. Its legs too, once they leave
+    the plumb (tipping towards prone they turn back about the hip and lie along the floor behind it, where
+    walking's own blocking no longer keeps them off a wall or a table); plumb, they stay as the paper's.
     """
     nh = int(body[B_N_CAPS])
+    first = 0 if nh != 6 and (ha[0, 0] != hb[0, 0] or ha[0, 1] != hb[0, 1]) else 2
     blocked = 0
     if obs_poly.shape[0]:
-        blocked = obstacles_blocked(obs_verts, obs_poly, obs_box, ha, hb, hr, 4 if nh == 6 else nh)
+        blocked = obstacles_blocked(obs_verts, obs_poly, obs_box, ha, hb, hr, first, 4 if nh == 6 else nh)
         if blocked and nh == 6:
             return blocked
     extent = body[B_HEAD_RISE] + body[B_R_HEAD] + body[B_SHOULDER_HALF]
@@ -165,7 +168,7 @@ def body_blocked(body, fences, obs_verts, obs_poly, obs_box, ha, hb, hr):
         x0, y0, x1, y1, zlo, zhi = fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3], fences[f, 4], fences[f, 5]
         if point_segment_2d(ha[2, 0], ha[2, 1], x0, y0, x1, y1) > extent:
             continue
-        for c in range(2, nh):
+        for c in range(first, nh):
             if blocked >> c & 1:
                 continue
             # (a capsule whose box misses the panel's by more than its radius cannot touch it: the articulated
@@ -281,13 +284,13 @@ def swept_blocked(body, fences, pa, pb, ha, hb, hr, n_caps):
 # Not inlined: move_worker is inlined into step_action and worker_paths, and one shared compiled copy of this
 # loop costs a cold compile less than two inlined ones (it runs once per time step either way).
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
-def obstacles_blocked(obs_verts, obs_poly, obs_box, ha, hb, hr, n_caps):
-    """Bit c set: capsule c (of 2 .. n_caps - 1: trunk, head and the articulated worker's arms) enters an
-    obstacle's prism."""
+def obstacles_blocked(obs_verts, obs_poly, obs_box, ha, hb, hr, first, n_caps):
+    """Bit c set: capsule c (of ``first`` .. n_caps - 1: the tipped legs, trunk, head and the articulated
+    worker's arms) enters an obstacle's prism."""
     blocked = 0
     for o in range(obs_poly.shape[0]):
         h = obs_box[o, 4]
-        for c in range(2, n_caps):
+        for c in range(first, n_caps):
             if blocked >> c & 1:
                 continue
             r = hr[c]

@@ -1,22 +1,15 @@
-"""benchmarks/iso13857_bound.py: the generous reach bound against hand cases and an independent sampling."""
+"""human/reach_bound.py: the generous reach bound against hand cases and an independent sampling."""
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-_PATH = Path(__file__).resolve().parents[2] / "benchmarks" / "iso13857_bound.py"
-_SPEC = importlib.util.spec_from_file_location("iso13857_bound", _PATH)
-bound = importlib.util.module_from_spec(_SPEC)
-sys.modules[_SPEC.name] = bound  # dataclasses look their module up there
-_SPEC.loader.exec_module(bound)
+from cellstress.human import reach_bound as bound
 
-BODY = bound.body_2d("p95-male", 180.0, 0.08)
+BODY = bound.body_bound("p95-male", 180.0, 0.08)
 
 
 def test_the_body_is_the_worker_s():
