@@ -154,3 +154,19 @@ def test_the_paper_worker_plays_bit_for_bit_as_before_crawling():
         h.update(sim.run(s.tolist()).rows.tobytes())
     h.update(np.asarray(sim.run_batch(seqs).unsafe_step).tobytes())
     assert h.hexdigest() == "a43f304061829a6df41cb9cad50fadc1d8520f47111e63f6e51384718ec3f1c8"
+
+
+@pytest.mark.parametrize("gap, lies_down", [(0.3, False), (1.5, True)])
+def test_lying_down_with_the_back_to_a_wall_keeps_the_legs_in_front_of_it(gap, lies_down):
+    """Tipping towards prone, the legs turn back about the hip and lie along the floor behind it. With the back
+    to a wall (crawl-under's front panel down to the floor) they stay in front of it: lying down there stops where
+    they would touch it. (They were once not held off panels: lying down by a 2.7 m wall put them 0.6 m through it,
+    and a search measured a reach beyond the wall at 0.2 m height.) Far from the wall the worker lies down."""
+    start = {"xy": [0.0, PANEL_Y + gap], "heading_deg": 90.0}  # facing away from the panel (it lies at -y)
+    doc = yaml.safe_load(builtin_text("crawl-under"))
+    sim = _crawl_under(0.0, extra={"human": dict(doc["human"], start=start)})
+    poses, (a, b, r) = _capsules(sim, ["stand+crawl", "stand+crawl"])
+    legs_back = np.minimum(a[:, :2, 1], b[:, :2, 1]) - r[:, :2]
+    assert legs_back.min() >= PANEL_Y - 1e-9
+    prone = np.allclose(b[-1, :2, 2], a[-1, :2, 2])  # the legs level with the hip: lying flat
+    assert prone is lies_down
