@@ -69,7 +69,7 @@ def check_rows(static, programs=()) -> tuple[CheckRow, ...]:
     for a in (static.approach, *static.robot_approaches):
         rows.append(CheckRow(_robot("undetected-reach", a.robot), "undetected reach", a.ok,
                              f"{_m(a.distance)} (needs {a.arm_allowance:.3f} m)", f"from {a.undetected_area:.1f} m^2 "
-                             "of floor the worker stands on unseen"))
+                             "of floor the worker stands on unseen", a.limit))
         if a.panels_at:
             fails = a.reach_over_fails
             # the simulated worker takes this way in unless it can reach over none of the failing panels

@@ -101,6 +101,8 @@ def _approach_lines(a, cycle: float) -> list[str]:
     else:
         out.append(f"  closest: stand at {_xy(a.stand)}, shoulder at {_xy(a.where.point)}, arm path "
                    f"{a.distance:.3f} m >= {a.arm_allowance:.2f} m? {_verdict(a.ok)}{_where(a.where, cycle)}")
+    if a.limit:
+        out.append(f"    {a.limit}")
     return out + _reach_over_lines(a, cycle)
 
 

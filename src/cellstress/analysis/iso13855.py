@@ -146,6 +146,7 @@ class ApproachCheck:
     robot: str = ""  # in a cell of several robots: the robot whose hazard zone it measures to
     guards: tuple[str, ...] = ()  # ... and the devices that stop that robot (the others do not count)
     panels_at: tuple[PanelReach, ...] = ()  # panels of 1 m or more the worker stands at unseen: ISO 13857 Table 2
+    limit: str = ""  # short only over panels the simulated worker cannot reach over: what it cannot do
 
     @property
     def reach_over_fails(self) -> tuple[PanelReach, ...]:
@@ -357,12 +358,36 @@ def _approach_check(spec, layout, zone: HazardZone, vol: HazardVolume, panels, l
         f = (dd - zone.r[k]) / dd if dd > 0 else 0.0
         hx, hy = px + (float(hp[1]) - px) * f, py + (float(hp[2]) - py) * f
         where = closest_on_zone(zone, (px, py), (hx, hy), k)
+    limit = _over_panels_limit(spec, layout, panels, vol, curtains, (U, fl, h, E, offs, zone), allowance) \
+        if best < allowance - 1e-9 else ""
     # the panels the worker stands at unseen: a walk-blocking panel keeps the centre a body radius away
     barriers = [p for p in panels if p.reach_over is not None]
     at = panels_at(X[U], Y[U], [(p.start, p.end) for p in barriers], radius + h)
     return ApproachCheck((float(sx), float(sy)), bool(detected), float(U.sum() * h * h), lean, allowance,
                          m_scan, m_curtain, stand, float(best), where, bool(best >= allowance - 1e-9),
-                         panels_at=tuple(_panel_reach(spec, layout, barriers[i], vol, side) for i, side in at))
+                         panels_at=tuple(_panel_reach(spec, layout, barriers[i], vol, side) for i, side in at),
+                         limit=limit)
+
+
+def _over_panels_limit(spec, layout, panels, vol, curtains, grid, allowance: float) -> str:
+    """The undetected reach fell short over panels that ISO 13857 Table 2 fails (open to any person): with those
+    the simulated worker cannot reach over (``worker_reach``) closed, is it met? Then that is the row's limit."""
+    U, fl, h, E, offs, zone = grid
+    shut = [p for p in panels if not p.closed and p.bottom <= 0.0 and p.reach_over is not None
+            and not p.reach_over.ok and worker_limit(spec.human, layout.params, p.start, p.end, p.top, vol, 0)]
+    if not shut:
+        return ""
+    walls = [(p.start, p.end) for p in panels if p.closed or p in shut] + curtains
+    arm_walls = extended_walls(walls)
+    nodes = detour_nodes(walls)
+    g, gi = node_values(nodes, zone.a, zone.b, zone.r, arm_walls)
+    best = closest_reach(U, fl.xmin, fl.ymin, h, E, offs, arm_walls, zone.a, zone.b, zone.r, arm_walls, nodes, g,
+                         gi)[0]
+    if best < allowance - 1e-9:
+        return ""
+    rest = "no arm path gets there" if math.isinf(best) else f"its shortest arm path is {best:.3f} m"
+    return (f"the arm comes that close only over {', '.join(p.name for p in shut)}, which the simulated worker cannot "
+            f"reach over (the reach-over row says why); kept out of them, {rest}")
 
 
 def _panel_reach(spec, layout, panel: FencePanel, vol: HazardVolume, side: int) -> PanelReach:
