@@ -127,8 +127,12 @@ def _reach_over_lines(a, cycle: float) -> list[str]:
             "high risk" + (f"; {low} lower than 1.4 m, which 4.4 allows only with further protective measures"
                            if low else "") + "): ")
     if fails:
-        return [head + f"{len(fails)} too close"] + [line for p in fails for line in
-                                                     (_panel_row(p, cycle), *(["      " + p.limit] if p.limit else []))]
+        out = [head + f"{len(fails)} too close"]
+        for p in fails:
+            out.append(_panel_row(p, cycle))
+            if p.limit:  # the simulated worker cannot reach over it (analysis.worker_reach)
+                out.append("      " + p.limit)
+        return out
     tight = min(a.panels_at, key=lambda p: p.reach.behind - p.reach.required)
     if math.isinf(tight.reach.behind):
         return [head + "no part of the hazard zone lies within the table's distances behind any of them: ok"]

@@ -101,7 +101,7 @@ def worker_limit(spec_human, params, p0, p1, top: float, vol: HazardVolume, side
     behind, c, lo, hi = tightest
     who = (f"the articulated worker ({spec_human.body}) gets at most {c:.2f} m beyond a {top:.2f} m top at "
            f"{lo:.1f}-{hi:.1f} m (the deepest its beam search over 8 actions finds: {TABLE})" if table is not None
-           else f"the simulated worker gets at most {c:.2f} m beyond a {top:.2f} m top at {lo:.1f}-{hi:.1f} m "
+           else f"it gets at most {c:.2f} m beyond a {top:.2f} m top at {lo:.1f}-{hi:.1f} m "
            f"(a bound on its body: jointless arm, trunk tilted {math.degrees(body.max_flexion):.0f} deg)")
     return (f"the simulated worker cannot reach over the panel: {who}, where the zone lies {behind:.2f} m behind; "
             "at the other heights the zone lies further beyond its reach")
