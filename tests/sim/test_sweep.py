@@ -8,10 +8,14 @@ import dataclasses
 
 import numpy as np
 import pytest
+from numba import njit
 
 from cellstress.sim import layout as L
+from cellstress.sim.geometry import segment_segment_xyz
 from cellstress.sim.kernels.dense import dense_batch
-from cellstress.sim.kernels.sweep import _moving_time, flag_distance
+from cellstress.sim.kernels.params import make_work
+from cellstress.sim.kernels.reach import reach_field_at
+from cellstress.sim.kernels.sweep import CERT_STEP, REACH_SLOPE, _certified, _moving_time, _sample, flag_distance
 from cellstress.sim.simulator import Simulator
 
 
@@ -97,3 +101,54 @@ def test_moving_time_leaves_out_the_dwells() -> None:
         assert abs(got - want) <= 2e-4 + 1e-9 and got == _moving_time(cycle, starts, move, dwell, b, a)
     assert _moving_time(cycle, starts, move, dwell, 0.1, 0.3) == 0.0  # inside the first dwell
     assert _moving_time(cycle, starts, move, dwell, 1.0, 6.0) == 5.0  # a cycle or more: all of it (an upper bound)
+
+
+@njit(cache=False)
+def _fine_minimum(P, W, spacing):
+    """The smallest distance between the robot and the worker posed in W, sampled every ``spacing`` along each
+    robot capsule's axis (the reach fields, fences ignored) and exact for the body capsules: the true distance is
+    at most this."""
+    best = np.inf
+    for c in range(P.cap_r.shape[0]):
+        r = P.cap_r[c]
+        a, b = W.ra[c], W.rb[c]
+        for k in range(int(P.body[L.B_N_CAPS])):
+            d2 = segment_segment_xyz(a[0], a[1], a[2], b[0], b[1], b[2], W.ha[k, 0], W.ha[k, 1], W.ha[k, 2],
+                                     W.hb[k, 0], W.hb[k, 1], W.hb[k, 2])[0]
+            best = min(best, np.sqrt(d2) - r - W.hr[k])
+        n = max(1, int(np.ceil(np.sqrt(((b - a) ** 2).sum()) / spacing)))
+        for i in range(n + 1):
+            p = a + (i / n) * (b - a)
+            for side in range(2):
+                f = reach_field_at(P.reach, P.scal[L.C_REACH_ORIGIN], P.scal[L.C_REACH_H], W.sh, W.tr, side, p[0],
+                                   p[1], p[2])
+                best = min(best, f - r)
+    return best
+
+
+def test_the_certified_bound_lies_below_the_distance_and_within_a_piece_of_it() -> None:
+    """``_certified`` skips whole runs of an axis: on random poses of the worker around the robot, at random
+    moments of its cycle (no fences: the field alone), its value never exceeds the distance sampled every 0.1 mm,
+    and lies within a 1 mm piece's slack of it."""
+    sim = Simulator("baseline")
+    P = sim.params._replace(fences=np.zeros((0, sim.params.fences.shape[1])))
+    W = make_work(P)
+    rng = np.random.default_rng(3)
+    state = sim.reset()
+    near = 0
+    for _ in range(300):
+        state[L.S_K] = float(rng.integers(1, 400))
+        t0 = (state[L.S_K] - 1) * sim.dt
+        _sample(P, state, state, W, 0.5, t0, W.srow)
+        c = int(rng.integers(P.cap_r.shape[0]))  # beside a random robot capsule, facing any way
+        angle, dist = rng.uniform(0, 2 * np.pi), rng.uniform(0.3, 1.3)
+        state[L.S_X] = 0.5 * (W.ra[c, 0] + W.rb[c, 0]) + dist * np.cos(angle)
+        state[L.S_Y] = 0.5 * (W.ra[c, 1] + W.rb[c, 1]) + dist * np.sin(angle)
+        state[L.S_HEADING] = rng.uniform(-np.pi, np.pi)
+        state[L.S_FWD], state[L.S_LAT] = rng.uniform(0.0, 1.0), rng.uniform(-0.4, 0.4)
+        _sample(P, state, state, W, 0.5, t0, W.srow)
+        bound, fine = _certified(P, W), _fine_minimum(P, W, 1e-4)
+        assert bound <= fine + 1e-12
+        assert bound >= fine - REACH_SLOPE * 0.5 * CERT_STEP - REACH_SLOPE * 1e-4
+        near += 0.0 < fine < 0.1
+    assert near > 10  # poses near the robot, where the bound is refined, were among them
