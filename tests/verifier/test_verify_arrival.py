@@ -12,8 +12,10 @@ import pytest
 
 import cellstress
 from cellstress.sim import layout as L
+from cellstress.sim.kernels.dense import dense_batch
 from cellstress.sim.scene import robot_capsules
 from cellstress.sim.simulator import Simulator
+from cellstress.sim.starts import parse_phase
 from cellstress.verifier.arrival import REACH_LIPSCHITZ, arrival_cover, capsule_margins, clock_dependence, inflated
 from cellstress.verifier.phases import start_points
 from cellstress.verifier.records import UNSAFE
@@ -93,16 +95,25 @@ def test_clock_reading_cells_are_covered_at_the_grid_only() -> None:
 
 
 def test_a_hazard_only_between_grid_moments_is_not_proved_safe(tmp_path) -> None:
-    # pass-by: the arm touches the worker only at moments strictly between the 50 ms samples of a grid arrival.
+    # pass-by: at the grid arrivals the arm touches the worker only at moments strictly between the 50 ms samples.
     # Sampled, the grid alone proved it safe; with contact in continuous time (kernels.sweep) the grid arrivals
     # already touch it between their samples, and every arrival moment agrees.
     cell = str(CELLS / "pass-by.yaml")
     grid = cellstress.verify(cell, moments="grid")
     assert grid.verdict == UNSAFE and grid.classes
     assert "only" in grid.scope.arrival
+    base = Simulator(cell)
+    real = 0
     for w in grid.classes:
-        trace = Simulator(cell).run(list(w.actions))
+        trace = base.run(list(w.actions))
         assert trace.unsafe and trace.rows[trace.unsafe_row, L.M_SWEPT] != 0.0  # between the samples
+        # a contact of the continuous motion (sampled 200 times per step), not only a conservative flag
+        sim = base.with_start(base.start, parse_phase(w.actions[0]))
+        acts = np.array([[base.action_index(a) for a in w.actions[1:]]], dtype=np.int64)
+        fine = np.empty(1, dtype=np.int64)
+        dense_batch(sim.params, sim.reset(), acts, 200, fine)
+        real += int(fine[0] >= 0)
+    assert real > 0
     res = cellstress.verify(cell, out=tmp_path)
     assert res.verdict == UNSAFE and res.classes
     for w in res.classes:
