@@ -19,7 +19,8 @@ time (under the latches of the step's start: a latch the step's end makes takes 
 or release re-anchors at its own moment, ``_path_time``). A contact found so counts like one at a step, with its
 own time (``M_TC``). After ``SWEEP_DEPTH`` halvings (1/32 of a step) a part that still cannot be cleared is tested
 on certified lower bounds instead of separation's values (``_certified``: body capsules exactly, each reach volume
-sampled along the capsule's axis every ``CERT_STEP`` less sqrt(3) times half of it), halved ``SWEEP_CERTIFIED``
+by its field on pieces of the capsule's axis at most ``CERT_STEP`` long, at each piece's middle less sqrt(3) times
+half the piece, whole runs of pieces bounded at once where they cannot undercut the rest), halved ``SWEEP_CERTIFIED``
 times more; what still cannot be cleared counts as a contact (``M_SWEPT`` 2): conservative, never a miss.
 ``benchmarks/sweep_check.py`` plays every built-in cell's episodes sampled ten times as finely and counts what the
 swept test misses (nothing) and what it flags that the fine samples do not.
@@ -260,22 +261,70 @@ def _possible(P, W):
     return body_blocked(P.body, W.fences, P.obs_verts, P.obs_poly, P.obs_box, W.ha, W.hb, W.hr) == 0
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _axis_bound(P, W, c, side, r, length, levels, n_near, through, best):
+    """``best`` lowered by robot capsule c's distance to reach volume ``side`` (see ``_certified``).
+
+    The axis is cut into 2**levels pieces, each at most ``CERT_STEP`` long, grouped in aligned blocks of a power
+    of two. A block is bounded from below at its middle by the field less its slope times half the block, and
+    the fence detour's lower bound less half the block. Each middle m lowers ``best`` to v(m) less the slack of a
+    single piece, v the larger of the field and the detour bound there, less the radius; a block whose bound is
+    not below ``best`` is done. Every point of the axis ends in a done block, whose bound was at least ``best``
+    then, so the ``best`` returned is a lower bound; and it is at least the smallest v less a piece's slack,
+    which is what sampling every piece guarantees. Depth first over the pieces without a stack: at piece i the
+    blocks that begin there are tried largest first."""
+    ra, rb = W.ra, W.rb
+    arm_len = P.body[B_ARM_LEN]
+    origin, grid_h = P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H]
+    sx, sy, sz = W.sh[side, 0], W.sh[side, 1], W.sh[side, 2]
+    n = 1 << levels
+    piece = REACH_SLOPE * 0.5 * length / n  # the slack of one piece
+    i = 0
+    while i < n:
+        size = n
+        while i % size != 0:
+            size >>= 1
+        while True:
+            u = (i + 0.5 * size) / n
+            half = 0.5 * length * size / n
+            px, py, pz = ra[c, 0] + u * (rb[c, 0] - ra[c, 0]), ra[c, 1] + u * (rb[c, 1] - ra[c, 1]), \
+                ra[c, 2] + u * (rb[c, 2] - ra[c, 2])
+            v = reach_field_at(P.reach, origin, grid_h, W.sh, W.tr, side, px, py, pz) - r
+            low = v - REACH_SLOPE * half
+            if low < best and n_near > 0 and not through:
+                # only the lower bound is wanted: a zero cutoff returns it before any bend is tried
+                g = fence_detour_bound(W.fences, W.near, np.int64(n_near), sx, sy, sz, px, py, pz,
+                                       0.0)[1] - arm_len - r
+                if g > v:
+                    v = g
+                if g - half > low:
+                    low = g - half
+            if v - piece < best:
+                best = v - piece
+            if low >= best or size == 1:  # (a piece's own bound is never below v less its slack)
+                break
+            size >>= 1
+        i += size
+    return best
+
+
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def _certified(P, W):
     """A lower bound on the distance between the robot and the worker as posed in W (by ``_sample``): body
-    capsules exactly; each reach volume by its field sampled along each robot capsule's axis at most
-    ``CERT_STEP`` apart, less the field's slope times half that spacing (every axis point lies within it of a
-    sample), less the radius. Fences only lengthen a reach: where a near panel holds the hand back, the fence
-    detour's lower bound (1-Lipschitz along an axis that crosses no panel) less half the spacing bounds it too, and
-    the larger of the two holds (without it, a reach held back by a panel near the robot could never be cleared)."""
+    capsules exactly; each reach volume by its field along each robot capsule's axis, on pieces at most
+    ``CERT_STEP`` long each bounded by the field at its middle less the field's slope times half its length,
+    less the radius (``_axis_bound`` skips whole runs of pieces that cannot undercut the bound found so far: the
+    same guarantee as sampling every piece). Fences only lengthen a reach: where a near panel holds the hand
+    back, the fence detour's lower bound (1-Lipschitz along an axis that crosses no panel) less half the piece
+    bounds it too, and the larger of the two holds (without it, a reach held back by a panel near the robot could
+    never be cleared)."""
     ra, rb, cap_r, ha, hb, hr = W.ra, W.rb, P.cap_r, W.ha, W.hb, W.hr
     n_caps = int(P.body[B_N_CAPS])
     arm_len = P.body[B_ARM_LEN]
     arm = arm_len + 2.0 * P.scal[C_REACH_H]  # every reach volume lies within this of its shoulder
-    origin, grid_h = P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H]
     n_near = collect_near_fences(W.fences, W.sh, W.near, arm_len + 0.05)  # as separation gathers them
     best = np.inf
-    for c in range(cap_r.shape[0]):
+    for c in range(cap_r.shape[0]):  # the body capsules first: their exact distances prune the reach volumes
         r = cap_r[c]
         for k in range(n_caps):
             d2 = segment_segment_xyz(ra[c, 0], ra[c, 1], ra[c, 2], rb[c, 0], rb[c, 1], rb[c, 2],
@@ -283,12 +332,14 @@ def _certified(P, W):
             d = np.sqrt(d2) - r - hr[k]
             if d < best:
                 best = d
-        if n_caps != N_BODY_CAPSULES:
-            continue  # (the articulated worker has no reach volumes)
+    if n_caps != N_BODY_CAPSULES:
+        return best  # (the articulated worker has no reach volumes)
+    for c in range(cap_r.shape[0]):
+        r = cap_r[c]
         length = np.sqrt((rb[c, 0] - ra[c, 0]) ** 2 + (rb[c, 1] - ra[c, 1]) ** 2 + (rb[c, 2] - ra[c, 2]) ** 2)
-        n = max(1, int(np.ceil(length / CERT_STEP)))
-        half = 0.5 * length / n  # every axis point lies within this of a sample
-        slack = REACH_SLOPE * half
+        levels = 0
+        while length > CERT_STEP * (1 << levels) and levels < 40:
+            levels += 1
         through = n_near > 0 and blocking_panel(W.fences, W.near, np.int64(n_near), ra[c, 0], ra[c, 1], ra[c, 2],
                                                 rb[c, 0], rb[c, 1], rb[c, 2]) >= 0
         for side in range(2):
@@ -298,19 +349,7 @@ def _certified(P, W):
                                      sx, sy, sz, sx, sy, sz)[0]
             if np.sqrt(d2) - arm - r >= best:
                 continue
-            for i in range(n + 1):
-                u = i / n
-                px, py, pz = ra[c, 0] + u * (rb[c, 0] - ra[c, 0]), ra[c, 1] + u * (rb[c, 1] - ra[c, 1]), \
-                    ra[c, 2] + u * (rb[c, 2] - ra[c, 2])
-                d = reach_field_at(P.reach, origin, grid_h, W.sh, W.tr, side, px, py, pz) - slack - r
-                if n_near > 0 and not through and d < best:
-                    # only the lower bound is wanted: a zero cutoff returns it before any bend is tried
-                    g_lb = fence_detour_bound(W.fences, W.near, np.int64(n_near), sx, sy, sz, px, py, pz,
-                                              0.0)[1] - arm_len - half - r
-                    if g_lb > d:
-                        d = g_lb
-                if d < best:
-                    best = d
+            best = _axis_bound(P, W, c, side, r, length, levels, n_near, through, best)
     return best
 
 
