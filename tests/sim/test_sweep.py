@@ -127,9 +127,9 @@ def _fine_minimum(P, W, spacing):
 
 
 def test_the_certified_bound_lies_below_the_distance_and_within_a_piece_of_it() -> None:
-    """``_certified`` on random poses of the worker around the robot, at random moments of its cycle (no fences:
-    the field alone): its value never exceeds the distance sampled every 0.1 mm, and lies within a 1 mm piece's
-    slack of it (whatever way it walks the axis: sample by sample now, or skipping runs of pieces)."""
+    """``_certified`` skips whole runs of an axis (``_axis_bound``): on random poses of the worker around the
+    robot, at random moments of its cycle (no fences: the field alone), its value never exceeds the distance
+    sampled every 0.1 mm, and lies within a 1 mm piece's slack of it."""
     sim = Simulator("baseline")
     P = sim.params._replace(fences=np.zeros((0, sim.params.fences.shape[1])))
     W = make_work(P)
