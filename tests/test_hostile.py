@@ -8,15 +8,18 @@ escaped for where it lands (terminal, HTML, CSV, Markdown).
 
 The cases are samples of kinds (files that are not files, bombs, deep nesting, numbers out of range, lax
 types, forged results, names that try to become paths or markup); the code under test handles the kind, not
-the sample. All cases run once, two at a time, in a module fixture; each test then checks one case.
+the sample. All cases run once per session, two at a time, in a fixture (``ran``: one xdist worker plays them,
+the others read its outcome); each test then checks one case.
 """
 
 from __future__ import annotations
 
 import copy
+import fcntl
 import json
 import math
 import os
+import pickle
 import subprocess
 import sys
 from collections.abc import Callable
@@ -888,7 +891,25 @@ def _run_group(cases: list[Case], folder: Path, commands: Path, forks: _Forks) -
 
 
 @pytest.fixture(scope="module")
-def ran(tmp_path_factory) -> dict[str, tuple[Path, Ran]]:
+def ran(tmp_path_factory, worker_id) -> dict[str, tuple[Path, Ran]]:
+    """Every case's outcome, played once per test session: the first xdist worker to need it plays the corpus
+    (minutes, two processes at a time) while the others wait on a lock, then read what it stored. (xdist's
+    ``loadgroup`` would do it, but does not group under pytest 9.2.)"""
+    shared = tmp_path_factory.getbasetemp()
+    if worker_id != "master":
+        shared = shared.parent  # the session's folder, above each worker's own
+    stored = shared / "hostile-ran.pickle"
+    with open(shared / "hostile-ran.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not stored.exists():
+            outcome = _play_corpus(tmp_path_factory)
+            part = stored.with_suffix(".part")
+            part.write_bytes(pickle.dumps(outcome))
+            part.replace(stored)
+    return pickle.loads(stored.read_bytes())
+
+
+def _play_corpus(tmp_path_factory) -> dict[str, tuple[Path, Ran]]:
     root = tmp_path_factory.mktemp("hostile")
     text = resources.files("cellstress.cell").joinpath("builtin", "baseline.yaml").read_text(encoding="utf-8")
     baseline = yaml.safe_load(text)

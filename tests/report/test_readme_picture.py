@@ -36,8 +36,14 @@ def readme_run(tmp_path_factory):
     return tmp_path, out_dir
 
 
-def _close_enough(made: np.ndarray, committed: np.ndarray, mean: float, share: float) -> None:
-    assert made.shape == committed.shape
+def _close_enough(made: np.ndarray, committed: np.ndarray, mean: float, share: float, edge: int = 0) -> None:
+    """The pictures agree: same size (to ``edge`` pixels each way, then compared on their common part), a mean
+    difference under ``mean`` and under ``share`` of the pixels off by more than 64 in a channel."""
+    assert made.shape[2:] == committed.shape[2:]
+    assert all(abs(a - b) <= edge for a, b in zip(made.shape[:2], committed.shape[:2], strict=True)), \
+        (made.shape, committed.shape)
+    rows, cols = min(made.shape[0], committed.shape[0]), min(made.shape[1], committed.shape[1])
+    made, committed = made[:rows, :cols], committed[:rows, :cols]
     diff = np.abs(made.astype(float) - committed.astype(float))
     assert diff.mean() < mean
     assert (diff.max(axis=2) > 64).mean() < share
@@ -82,5 +88,6 @@ def test_readme_3d_picture_is_regenerated(readme_run, tmp_path):
     committed = ROOT / picture
     if os.environ.get("CELLSTRESS_WRITE_PICTURES") == "1":
         Image.fromarray(shot.astype(np.uint8)).save(committed, optimize=True)
-    # WebGL through SwiftShader: another Chromium may shade a few edges differently, never the scene
-    _close_enough(shot, np.asarray(Image.open(committed).convert("RGB"), dtype=np.int16), 4.0, 0.03)
+    # WebGL through SwiftShader: another Chromium may shade a few edges differently, never the scene; and it may
+    # round the element's fractional height to a pixel more or less (Chromium 150: 849 rows, the picture 850)
+    _close_enough(shot, np.asarray(Image.open(committed).convert("RGB"), dtype=np.int16), 4.0, 0.03, edge=2)
