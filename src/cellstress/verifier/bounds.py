@@ -36,15 +36,17 @@ class Bounds:
         # The kernel test is d_HR <= DTOL and v_R > VTOL; a robot at rest has v_R == 0 exactly (see docs), so it is
         # never unsafe when VTOL >= 0. A criterion that judges contacts itself (VTOL inf: no kernel test) may call
         # a contact with a standing robot unsafe (ISO/TS 15066 clamping), so the bound does not apply to it.
-        # Both bounds rest on the robot running its path at full speed until a stop that holds for good. A device
-        # that restarts the robot by itself or slows it with a warning field breaks that (Layout.stops_latch):
-        # then no bound is used, and the tree is decided in full.
+        # ``at-rest`` rests on a latched stop holding for good: a device that restarts the robot by itself breaks
+        # that, and one that slows it (a warning field, speed and separation monitoring) is not taken apart from
+        # the stop, nor is one robot's stop from another's (Layout.stops_latch: False in all these cells).
+        # ``distance`` rests only on each robot's path time advancing no faster than the clock, which every device
+        # keeps (verifier.reach).
         latch = sim.layout.stops_latch
         self.at_rest = latch and AT_REST in enabled and sim.contacts is None and 0.0 <= vtol < np.inf
         # Every criterion judges contacts only (d_HR at most its distance tolerance, the kernel's DTOL; a criterion
         # without a kernel test is shown only the rows within it, Simulator.first_unsafe): the distance bound holds
         # for all of them.
-        self.swept = SweptField(sim, horizon) if latch and DISTANCE in enabled else None
+        self.swept = SweptField(sim, horizon) if DISTANCE in enabled else None
 
     def prune(self, children: np.ndarray, last: np.ndarray, alive: np.ndarray, left: int
               ) -> Iterator[tuple[str, np.ndarray]]:

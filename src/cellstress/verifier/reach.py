@@ -7,9 +7,12 @@ reach). The reach field is a grid, so ``REACH_SLACK`` grid spacings are added fo
 only when the worker walks, by one stride (walking speed x dt) per step at most; turning and bending do not move
 it.
 
-**The robot.** Before its stop takes effect the robot's path time is tau0 + t; braking only slows it down
-(``kernels.robot.path_time``), and a stop latched later takes effect later. So at a step k' after step k,
-whatever the devices do, the robot's pose is its path's pose at some path time in [tau0 + k dt, tau0 + k' dt].
+**The robot.** Its pose is always its path's pose at the path time tau the state holds (``kernels.robot``:
+``path_time``, ``live_path_time``), and tau advances at a rate sigma in [0, 1]: one second per second until a
+stop takes effect, then slower; an automatic restart ramps sigma back up to 1 at most, a warning field or a
+speed and separation monitor down to its fraction, never above 1, and nothing turns it back. So at a step k' after
+step k, whatever the devices do, the robot's pose is its path's pose at some path time in
+[tau_k, tau_k + (k' - k) dt], tau_k the state's own (tau0 + k dt until a stop takes effect).
 The path is sampled every ``dt / SUB`` of path time; between samples no point of a capsule axis moves more than
 ``speed`` x half the spacing, where ``speed`` bounds every capsule point's speed along the path: the sum over the
 joints that move it of the joint's peak speed (a minimum-jerk segment peaks at 1.875 times its mean speed) times
@@ -20,9 +23,10 @@ prismatic joints in between, and the capsule's end), plus each prismatic joint's
 height) to the sample's capsules, less the sampling allowance and half a grid diagonal: the true distance from
 any H to that sample's neighbourhood is at least its nearest node's value.
 
-A state at step k whose stop has not taken effect is safe when, for every later step k' of the episode, the
-least of those values over the samples of path times [tau0 + k dt, tau0 + k' dt] at its pivot's node, less
-(k' - k) strides and the worker's radius, exceeds the criterion's contact distance.
+A state at step k is safe when, for every later step k' of the episode, the least of those values over the
+samples of path times [tau_k, tau_k + (k' - k) dt] at its pivot's node, less (k' - k) strides and the worker's
+radius, exceeds the criterion's contact distance. With several robots, each has its own field (its capsules,
+its speed bound) and its own path time, and the bound is the least over them.
 """
 
 from __future__ import annotations
@@ -32,6 +36,7 @@ import numpy as np
 from cellstress.core.jit import njit, prange
 from cellstress.sim import layout as L
 from cellstress.sim.kernels.body import worker_radius as body_radius
+from cellstress.sim.kernels.robot import live_path_time, path_time
 from cellstress.sim.kernels.sweep import flag_distance
 from cellstress.sim.scene import robot_capsules
 from cellstress.sim.speeds import capsule_speeds
@@ -46,9 +51,9 @@ def worker_radius(body: np.ndarray, reach_spacing: float) -> float:
     return float(body_radius(body, 0.0, reach_spacing))
 
 
-def robot_point_speed(layout) -> float:
-    """An upper bound on the speed of any point of any of robot 0's capsule axes per second of path time."""
-    return float(capsule_speeds(layout.robots[0]).max(initial=0.0))
+def robot_point_speed(layout, robot: int = 0) -> float:
+    """An upper bound on the speed of any point of any of one robot's capsule axes per second of path time."""
+    return float(capsule_speeds(layout.robots[robot]).max(initial=0.0))
 
 
 class SweptField:
@@ -58,6 +63,8 @@ class SweptField:
         P = sim.params
         self.dt = float(P.scal[L.C_DT])
         self.spa = P.spa
+        # each robot's own constants (robot 0's, then the others'): its phase, stopping time, stop category
+        self.scal = np.ascontiguousarray(np.vstack([P.scal[None, :], P.x_scal]) if len(P.x_scal) else P.scal[None, :])
         # a step may count as unsafe up to this d_HR: the contact distance, or where the swept test between the
         # steps cannot rule a contact out (kernels.sweep.flag_distance)
         self.dtol = flag_distance(P) if P.scal[L.C_SWEEP] != 0.0 else float(P.scal[L.C_DTOL])
@@ -66,64 +73,74 @@ class SweptField:
         self.hip = float(P.body[L.B_HIP_Z])
         steps = horizon * self.spa
         delta = self.dt / SUB
-        tau0 = float(P.scal[L.C_PHASE0])
+        tau0 = self.scal[:, L.C_PHASE0]
         n = steps * SUB + 2
         ra = np.empty((n, len(P.cap_r), 3))
         rb = np.empty_like(ra)
-        for i in range(n):
+        for i in range(n):  # every robot at its own path time (its phase + i delta)
             ra[i], rb[i] = robot_capsules(sim.layout, tau0 + i * delta)
-        self.allowance = robot_point_speed(sim.layout) * delta / 2.0
         fl = P.floor
         self.x0, self.y0 = float(fl[0]), float(fl[2])
         nx = int(np.ceil((fl[1] - fl[0]) / GRID)) + 1
         ny = int(np.ceil((fl[3] - fl[2]) / GRID)) + 1
-        self.samples = np.empty((n, nx, ny))
-        _sample_field(ra, rb, P.cap_r, self.x0, self.y0, GRID, self.hip, self.samples)
-        self.samples -= self.allowance + GRID * np.sqrt(0.5)
+        self.samples = np.empty((len(self.scal), n, nx, ny))
+        for r in range(len(self.scal)):
+            own = np.flatnonzero(P.cap_robot == r)
+            _sample_field(np.ascontiguousarray(ra[:, own]), np.ascontiguousarray(rb[:, own]),
+                          np.ascontiguousarray(P.cap_r[own]), self.x0, self.y0, GRID, self.hip, self.samples[r])
+            self.samples[r] -= robot_point_speed(sim.layout, r) * delta / 2.0 + GRID * np.sqrt(0.5)
 
-    def lower_bound(self, step: int, steps_left: int, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """A lower bound, over the next ``steps_left`` steps after step ``step``, on the distance from the hip
-        pivot (started at (x, y), walking a stride a step) to the robot: for each later step k, the least
-        distance to the samples of path times [tau0 + step dt, tau0 + k dt] (one more sample each side, for
-        rounding), less the strides walked by step k."""
-        out = np.empty(len(x))
-        _window_bound(self.samples, self.x0, self.y0, GRID, SUB, int(step), int(steps_left), self.stride,
-                      np.ascontiguousarray(x), np.ascontiguousarray(y), out)
+    def lower_bound(self, states: np.ndarray, steps_left: int) -> np.ndarray:
+        """A lower bound, over the next ``steps_left`` steps after each of ``states``, on the distance from the
+        hip pivot (started at the state's (x, y), walking a stride a step) to the robots: for each later step k'
+        and each robot, the least distance to its samples of path times [tau_k, tau_k + (k' - k) dt] (its own
+        path time tau_k; one more sample each side, for rounding), less the strides walked by then."""
+        states = np.ascontiguousarray(states)
+        out = np.empty(len(states))
+        _window_bound(self.samples, self.x0, self.y0, GRID, SUB, self.dt, self.scal, int(steps_left), self.stride,
+                      states, out)
         return out
 
     def safe(self, children: np.ndarray, steps_left: int) -> np.ndarray:
-        """Children (all at the same step) that no completion of ``steps_left`` steps brings within the contact
-        distance; only those whose stop has not taken effect (the window assumes it)."""
+        """Children that no completion of ``steps_left`` steps brings within the contact distance."""
         if not len(children):
             return np.zeros(0, dtype=bool)
-        step = int(children[0, L.S_K])
-        t = children[:, L.S_K] * self.dt
-        d = self.lower_bound(step, steps_left, children[:, L.S_X], children[:, L.S_Y])
-        return (t < children[:, L.S_TSTOP]) & (d - self.radius > self.dtol)
+        return self.lower_bound(children, steps_left) - self.radius > self.dtol
 
 
 @njit(cache=True)
-def _window_bound(samples, x0, y0, g, sub, step, steps_left, stride, xs, ys, out):
-    """``SweptField.lower_bound``: out[c] = min over k in step+1..step+steps_left of (least sample value at the
-    hip pivot's grid node over samples (step * sub - 1) .. (k * sub + 1)) - (k - step) * stride."""
-    nx, ny, n = samples.shape[1], samples.shape[2], samples.shape[0]
-    lo = max(0, step * sub - 1)
-    for c in range(xs.shape[0]):
-        ix = min(max(int(np.rint((xs[c] - x0) / g)), 0), nx - 1)
-        iy = min(max(int(np.rint((ys[c] - y0) / g)), 0), ny - 1)
+def _window_bound(samples, x0, y0, g, sub, dt, scal, steps_left, stride, states, out):
+    """``SweptField.lower_bound``: out[c] = min over robots r and j in 1..steps_left of (least value of robot r's
+    samples at the hip pivot's grid node from its path time tau_c to tau_c + j dt, one more each side) -
+    j * stride; tau_c robot r's path time in state c, counted in samples (an exact whole number on the plain
+    path before a stop). Only robot 0 leaves the plain path model (``S_LIVE``); the others stop for good."""
+    nx, ny, n = samples.shape[2], samples.shape[3], samples.shape[1]
+    for c in range(states.shape[0]):
+        k = states[c, L.S_K]
+        t = k * dt
+        ix = min(max(int(np.rint((states[c, L.S_X] - x0) / g)), 0), nx - 1)
+        iy = min(max(int(np.rint((states[c, L.S_Y] - y0) / g)), 0), ny - 1)
         best = np.inf
-        run = np.inf
-        i = lo
-        for k in range(step + 1, step + steps_left + 1):
-            hi = min(k * sub + 1, n - 1)
-            while i <= hi:
-                v = samples[i, ix, iy]
-                if v < run:
-                    run = v
-                i += 1
-            b = run - (k - step) * stride
-            if b < best:
-                best = b
+        for r in range(samples.shape[0]):
+            t_stop = states[c, L.S_TSTOP] if r == 0 else states[c, L.S_XTSTOP + r - 1]
+            if r == 0 and states[c, L.S_LIVE] != 0.0:
+                start = (live_path_time(scal[r], states[c], t)[0] - scal[r, L.C_PHASE0]) / (dt / sub)
+            elif t < t_stop:
+                start = k * sub  # (path_time: its phase + t)
+            else:
+                start = (path_time(scal[r], t, t_stop)[0] - scal[r, L.C_PHASE0]) / (dt / sub)
+            run = np.inf
+            i = max(0, int(np.floor(start)) - 1)
+            for j in range(1, steps_left + 1):
+                hi = min(int(np.ceil(start + j * sub)) + 1, n - 1)
+                while i <= hi:
+                    v = samples[r, i, ix, iy]
+                    if v < run:
+                        run = v
+                    i += 1
+                b = run - j * stride
+                if b < best:
+                    best = b
         out[c] = best
 
 
