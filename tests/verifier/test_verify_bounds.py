@@ -13,7 +13,7 @@ import pytest
 from cellstress.sim import layout as L
 from cellstress.sim.scene import robot_capsules
 from cellstress.sim.simulator import Simulator
-from cellstress.verifier.bounds import Bounds
+from cellstress.verifier.bounds import AT_REST, Bounds
 from cellstress.verifier.reach import SweptField, robot_point_speed, worker_radius
 
 FEATURES = Path(__file__).parent / "cells"
@@ -93,25 +93,32 @@ def test_distance_bound_never_above_a_later_d_hr(cell) -> None:
         assert braking > 0 and live > 0
 
 
-@pytest.mark.parametrize("cell", ["baseline", str(FEATURES / "linear-axis.yaml"), "door-unlocked"])
-def test_a_robot_at_rest_stays_at_rest(cell) -> None:
-    sim = Simulator(cell)  # its devices stop the robot when the worker walks in (or pushes the door)
+# (cell, actions drawn from 0..n-1: walking with any posture into the cell, or anything from inside it)
+AT_REST_CELLS = [("baseline", 6), (str(FEATURES / "linear-axis.yaml"), 6), ("door-unlocked", 6),
+                 (str(FEATURES / "two-stop.yaml"), 30)]
+
+
+@pytest.mark.parametrize(("cell", "n_actions"), AT_REST_CELLS)
+def test_a_robot_at_rest_stays_at_rest(cell, n_actions) -> None:
+    sim = Simulator(cell)  # its devices stop the robot(s) when the worker walks in (or pushes the door)
     n = max(8, sim.actions_per_episode)
     bounds = Bounds(sim, horizon=n)
+    assert bounds.at_rest
+    x_phases = [L.M_XPHASE + r for r in range(sim.params.x_scal.shape[0])]
     rng = np.random.default_rng(3)
     rested = 0
-    for acts in rng.integers(0, 6, size=(400, n)):  # walking (with any posture), into the cell
+    for acts in rng.integers(0, n_actions, size=(400, n)):
         rows = sim.run(acts).rows
-        t_stop = np.inf
         state = sim.reset()
-        for a in acts:
+        for i, a in enumerate(acts):
             state, _ = sim.step(state, int(a))
             if sim.is_unsafe(state):
                 break
-            t_stop = state[L.S_TSTOP]
-            if state[L.S_K] * sim.dt - t_stop >= bounds.stop_time:
+            cut = dict(bounds.prune(state[None, :], rows[-1:], np.ones(1, dtype=bool), n - 1 - i))[AT_REST]
+            if cut[0]:  # every robot stands (robot 0's speed 0, the others stopped), and nothing is unsafe
                 later = rows[int(state[L.S_K]) + 1:]
                 assert np.all(later[:, L.M_V] == 0.0) and not later[:, L.M_UNSAFE].any()
+                assert np.all(later[:, x_phases] == L.PHASE_STOPPED)
                 rested += 1
                 break
     assert rested >= 5  # (most walks in linear-axis end at the arm first)

@@ -58,6 +58,7 @@ FEATURE_CELLS = [
     ("door-near", (0.0,)),  # a guard door without guard locking
     ("muting-near", (4.0,)),  # a muted curtain
     ("two-near", (0.0,)),  # two robots, the curtain stopping one
+    ("two-stop", (0.0, 1.0)),  # two robots, the curtain stopping both (at rest once both stand)
     ("linear-axis", (0.0, 1.0)),  # a prismatic joint, a long stop
 ]
 

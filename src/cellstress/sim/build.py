@@ -150,12 +150,11 @@ class Layout:
 
     @property
     def stops_latch(self) -> bool:
-        """True when every stop holds for the rest of the episode and no device changes the robot's speed
-        otherwise (every device restarts manually, none has a warning field): once a latched stop has taken
-        full effect the robot is at rest for good. False with an automatic restart or a warning field, and in a
-        cell of several robots (the verifier's bounds assume one: docs/verify.md)."""
-        return bool(np.all(self.params.dev_clear == np.inf) and np.all(self.params.dev_speed == 0.0)
-                    and self.params.x_scal.shape[0] == 0)
+        """True when every stop holds for the rest of the episode and no device changes a robot's speed
+        otherwise (every device restarts manually, none has a warning field or monitors the separation): once a
+        robot's latched stop has taken full effect it is at rest for good (each robot of a cell of several by its
+        own stop). False with an automatic restart, a warning field or speed and separation monitoring."""
+        return bool(np.all(self.params.dev_clear == np.inf) and np.all(self.params.dev_speed == 0.0))
 
 
 PEDESTAL = "robot-pedestal"

@@ -4,8 +4,8 @@ Each bound takes a layer's children (states after an action, and the metric row 
 says which of the living ones are safe for every completion of ``r`` more actions. docs/verify.md gives each
 soundness argument; ``tests/verify/test_bounds.py`` checks the assumptions they rest on over many random steps.
 
-* ``at-rest``: a latched stop has taken full effect: the robot stands for good, and the criterion's kernel test
-  needs it to move.
+* ``at-rest``: every robot's latched stop has taken full effect: the robots stand for good, and the criterion's
+  kernel test needs one to move.
 * ``distance``: the worker cannot come within the criterion's contact distance of anything the robot can occupy
   in the time left (``verifier.reach``).
 """
@@ -38,11 +38,12 @@ class Bounds:
         # a contact with a standing robot unsafe (ISO/TS 15066 clamping), so the bound does not apply to it.
         # ``at-rest`` rests on a latched stop holding for good: a device that restarts the robot by itself breaks
         # that, and one that slows it (a warning field, speed and separation monitoring) is not taken apart from
-        # the stop, nor is one robot's stop from another's (Layout.stops_latch: False in all these cells).
-        # ``distance`` rests only on each robot's path time advancing no faster than the clock, which every device
-        # keeps (verifier.reach).
+        # the stop (Layout.stops_latch: False with either). In a cell of several robots every robot must stand,
+        # each by its own stop. ``distance`` rests only on each robot's path time advancing no faster than the
+        # clock, which every device keeps (verifier.reach).
         latch = sim.layout.stops_latch
         self.at_rest = latch and AT_REST in enabled and sim.contacts is None and 0.0 <= vtol < np.inf
+        self.x_stop_times = np.asarray(sim.params.x_scal[:, L.C_STOP_TIME], dtype=float)  # robots 1..
         # Every criterion judges contacts only (d_HR at most its distance tolerance, the kernel's DTOL; a criterion
         # without a kernel test is shown only the rows within it, Simulator.first_unsafe): the distance bound holds
         # for all of them.
@@ -53,7 +54,11 @@ class Bounds:
         """(bound name, mask of living children it proves safe for all ``left`` more actions), in order."""
         t = children[:, L.S_K] * self.dt
         if self.at_rest:
-            # the kernel's own test of a completed stop (path_time): t - t_stop >= T, in the same float arithmetic
-            yield AT_REST, alive & (t - children[:, L.S_TSTOP] >= self.stop_time)
+            # the kernel's own test of a completed stop (path_time): t - t_stop >= T, in the same float arithmetic,
+            # for robot 0 and for every other robot with its own stop and stopping time
+            rest = t - children[:, L.S_TSTOP] >= self.stop_time
+            for r, stop_time in enumerate(self.x_stop_times):
+                rest &= t - children[:, L.S_XTSTOP + r] >= stop_time
+            yield AT_REST, alive & rest
         if self.swept is not None:
             yield DISTANCE, alive & self.swept.safe(children, left * self.spa)
