@@ -54,6 +54,7 @@ CELLS = Path(__file__).parent / "cells"
 FEATURE_CELLS = [
     ("restart-fast", (0.0, 2.5)),  # automatic restart after 0.1 s
     ("warning-trunk", (4.35, 0.55)),  # a trunk-height warning field that releases after 0.1 s
+    ("warning-hold", (4.35, 0.55)),  # the same with the stop held: at rest behind a warning field
     ("ssm-near", (1.0, 2.0)),  # speed and separation monitoring
     ("door-near", (0.0,)),  # a guard door without guard locking
     ("muting-near", (4.0,)),  # a muted curtain

@@ -156,6 +156,14 @@ class Layout:
         own stop). False with an automatic restart, a warning field or speed and separation monitoring."""
         return bool(np.all(self.params.dev_clear == np.inf) and np.all(self.params.dev_speed == 0.0))
 
+    @property
+    def stops_hold(self) -> bool:
+        """True when no device that stops a robot restarts it by itself: a latched stop holds for the rest of the
+        episode, whatever warning fields or a separation monitor do to the speed before it (their releases and
+        commands keep a latched stop's target speed at 0: ``kernels.step.release``, ``kernels.scaling``)."""
+        stops = self.params.dev_speed == 0.0
+        return bool(np.all(self.params.dev_clear[stops] == np.inf))
+
 
 PEDESTAL = "robot-pedestal"
 

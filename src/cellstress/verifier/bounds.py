@@ -22,6 +22,7 @@ from cellstress.verifier.reach import SweptField
 AT_REST = "at-rest"
 DISTANCE = "distance"
 BOUND_NAMES = (AT_REST, DISTANCE)
+REST_VTOL = 1e-9  # m/s: see Bounds (at rest behind a warning field or a separation monitor)
 
 
 class Bounds:
@@ -37,12 +38,15 @@ class Bounds:
         # never unsafe when VTOL >= 0. A criterion that judges contacts itself (VTOL inf: no kernel test) may call
         # a contact with a standing robot unsafe (ISO/TS 15066 clamping), so the bound does not apply to it.
         # ``at-rest`` rests on a latched stop holding for good: a device that restarts the robot by itself breaks
-        # that, and one that slows it (a warning field, speed and separation monitoring) is not taken apart from
-        # the stop (Layout.stops_latch: False with either). In a cell of several robots every robot must stand,
-        # each by its own stop. ``distance`` rests only on each robot's path time advancing no faster than the
-        # clock, which every device keeps (verifier.reach).
-        latch = sim.layout.stops_latch
-        self.at_rest = latch and AT_REST in enabled and sim.contacts is None and 0.0 <= vtol < np.inf
+        # that (Layout.stops_hold). Behind a warning field or a separation monitor the robot's time scaling is
+        # ramped in closed form (``live_path_time``), which reaches 0 at most one stopping time after the stop in
+        # exact arithmetic; in floating point a re-anchored ramp may end a rounding error later, a speed of
+        # ~1e-16 of the path's, so there the criterion's speed tolerance must be at least REST_VTOL. In a cell of
+        # several robots every robot must stand, each by its own stop. ``distance`` rests only on each robot's
+        # path time advancing no faster than the clock, which every device keeps (verifier.reach).
+        layout = sim.layout
+        vtol_ok = 0.0 <= vtol < np.inf if layout.stops_latch else REST_VTOL <= vtol < np.inf
+        self.at_rest = layout.stops_hold and AT_REST in enabled and sim.contacts is None and vtol_ok
         self.x_stop_times = np.asarray(sim.params.x_scal[:, L.C_STOP_TIME], dtype=float)  # robots 1..
         # Every criterion judges contacts only (d_HR at most its distance tolerance, the kernel's DTOL; a criterion
         # without a kernel test is shown only the rows within it, Simulator.first_unsafe): the distance bound holds
