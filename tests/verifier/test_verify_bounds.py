@@ -16,7 +16,7 @@ from cellstress.sim import layout as L
 from cellstress.sim.scene import robot_capsules
 from cellstress.sim.simulator import Simulator
 from cellstress.verifier.bounds import AT_REST, Bounds
-from cellstress.verifier.reach import SweptField, robot_point_speed, worker_radius
+from cellstress.verifier.reach import SweptField, field_height, robot_point_speed, worker_radius, worker_stride
 
 FEATURES = Path(__file__).parent / "cells"
 # the paper's cells, a prismatic joint (linear-axis), a guard door and a muted curtain (the bounds' cells: every
@@ -34,12 +34,38 @@ def test_worker_within_its_radius_and_a_stride(cell) -> None:
     stride = P.body[L.B_WALK_SPEED] * sim.dt
     steps = np.hypot(*np.diff(paths.reshape(200, -1, L.N_POSE)[:, :, :2], axis=1).transpose(2, 0, 1))
     assert steps.max() <= stride * (1 + 1e-12)
-    radius = worker_radius(P.body, float(P.scal[L.C_REACH_H]))
+    radius = worker_radius(P)
+    assert field_height(P) == P.body[L.B_HIP_Z] and radius == P.scal[L.C_RHO]  # the paper's worker: no stance
     poses = paths[rng.choice(len(paths), 400, replace=False)]
     hip = np.column_stack([poses[:, :2], np.full(len(poses), P.body[L.B_HIP_Z])])
     points = hip[:, None, :] + rng.uniform(-2.5, 2.5, size=(len(poses), 64, 3))
     d = sim.worker_distances(poses, points)
     assert np.all(d >= np.linalg.norm(points - hip[:, None, :], axis=2) - radius)
+
+
+# the articulated worker (119 actions: it crouches, kneels, lies prone and crawls, rises on tiptoe, reaches)
+ARTICULATED_CELLS = ["reach-over", "crawl-under", str(FEATURES / "reach-near.yaml")]
+
+
+@pytest.mark.parametrize("cell", ARTICULATED_CELLS)
+def test_articulated_worker_within_its_radius_and_a_stride(cell) -> None:
+    sim = Simulator(cell)
+    P = sim.params
+    rng = np.random.default_rng(4)
+    crawl = [i for i, name in enumerate(sim.action_names) if name.endswith("+crawl")]
+    acts = rng.integers(0, sim.n_actions, size=(300, 10))
+    acts[::3, :3] = rng.choice(crawl, size=(100, 3))  # a third lie down and crawl first
+    paths = sim.worker_paths(acts)
+    steps = np.hypot(*np.diff(paths[:, :, :2], axis=1).transpose(2, 0, 1))
+    assert steps.max() <= worker_stride(P) * (1 + 1e-12)
+    poses = paths.reshape(-1, L.N_POSE)
+    drops = poses[:, L.POSE_EXT]
+    assert drops.min() < -0.8 and drops.max() > 0.05  # prone and on tiptoe were among them
+    a, b, r = sim.worker_capsules(poses)
+    pivot = np.column_stack([poses[:, :2], np.full(len(poses), field_height(P))])[:, None, :]
+    reach = np.maximum(np.linalg.norm(a - pivot, axis=2), np.linalg.norm(b - pivot, axis=2)) + r
+    assert reach.max() <= worker_radius(P)
+    assert reach.max() > 0.8 * worker_radius(P)  # and not a uselessly loose radius
 
 
 @pytest.mark.parametrize("cell", CELLS)
@@ -63,9 +89,10 @@ SPEED_CELLS = ["restart-auto", "warning-field-short", "ssm-latency", str(FEATURE
 ROBOTS_CELLS = ["two-robots", str(FEATURES / "two-near.yaml")]
 
 
-@pytest.mark.parametrize("cell", CELLS + SPEED_CELLS + ROBOTS_CELLS)
+@pytest.mark.parametrize("cell", CELLS + SPEED_CELLS + ROBOTS_CELLS + ARTICULATED_CELLS)
 def test_distance_bound_never_above_a_later_d_hr(cell) -> None:
     base = Simulator(cell)
+    walking = np.array([i for i, name in enumerate(base.action_names) if name.startswith("walk+")])
     rng = np.random.default_rng(2)
     phases = rng.choice(np.arange(0.0, base.layout.trajectory.cycle, 0.05), 4, replace=False)
     braking = live = 0
@@ -74,9 +101,9 @@ def test_distance_bound_never_above_a_later_d_hr(cell) -> None:
         field = SweptField(sim, 8)
         spa = sim.steps_per_action
         # walking (any posture) at the robot half the time, so that devices stop, slow and restart it
-        for n, acts in enumerate(rng.integers(0, 30, size=(60, 8))):
+        for n, acts in enumerate(rng.integers(0, sim.n_actions, size=(60, 8))):
             if n % 2:
-                acts = acts % 6
+                acts = walking[acts % len(walking)]
             rows = sim.run(acts).rows
             state = sim.reset()
             for layer in range(1, 8):

@@ -1,8 +1,9 @@
 """The exact decision against brute force: at 3 and 4 actions the hazardous-sequence count of every built-in
 cell (one start point each, at its own phase and at another) and of test cells made to have hazards there
 for each feature (automatic restart, warning field, speed and separation monitoring, guard door, muting,
-several robots, a prismatic joint: tests/verifier/cells) equals playing every sequence: all 30^3 with
-``Simulator.run_batch``, all 30^4 prefix by prefix without merging or bounds (``verify_brute``); every witness
+several robots, a prismatic joint, the articulated worker: tests/verifier/cells) equals playing every sequence:
+all 30^3 with ``Simulator.run_batch``, all 30^4 prefix by prefix without merging or bounds (``verify_brute``;
+the articulated worker's 119^2 and 119^3 too); every witness
 is a real, bit-exact episode; a searcher's hazard lies in the verifier's hazardous set."""
 
 from __future__ import annotations
@@ -36,8 +37,9 @@ def _start_sim(cell: str, phase: float | None = None) -> Simulator:
     return sim.with_start(s.pose, arrival_phases(sim, s, "cell")[0] if phase is None else phase)
 
 
-# the verifier enumerates the paper worker's 30 actions (verifier.tree); the articulated worker's cells are not its
+# the paper worker's 30 actions; the articulated worker's 119 (its cells: below)
 PAPER_CELLS = tuple(c for c in BUILTIN_CELLS if load_cell(c).spec.human.model == "paper")
+ARTICULATED_CELLS = tuple(c for c in BUILTIN_CELLS if c not in PAPER_CELLS)
 
 
 @pytest.mark.parametrize(("cell", "phase"), [(c, None) for c in PAPER_CELLS] + [("s1-scanner-width", 3.0)])
@@ -134,3 +136,27 @@ def test_searchers_hazard_on_s3_is_in_the_hazardous_set() -> None:
     bounds = Bounds(sim, horizon=len(actions))
     out = decide(sim, len(actions), bounds, keep=True)
     assert lookup(sim, out, bounds, actions) == "hazardous"
+
+
+# The articulated worker: 119^2 = 14,161 sequences at 2 actions, 119^3 = 1,685,159 at 3 (prefix by prefix: about
+# a minute), so every built-in cell at 2 and a test cell made to have hazards there (reach-near: a hand over a low
+# panel into the arm's path, a curtain behind the panel that stops the robot) at 2 and 3.
+@pytest.mark.parametrize(("cell", "phase"), [(c, None) for c in ARTICULATED_CELLS]
+                         + [(str(CELLS / "reach-near.yaml"), p) for p in (1.0, 1.5, 4.0)])
+def test_articulated_counts_equal_brute_force_two_actions(cell, phase) -> None:
+    sim = _start_sim(cell, phase)
+    assert sim.n_actions == 119
+    out = decide(sim, 2, Bounds(sim, horizon=2))
+    assert out.decided
+    assert out.hazardous == brute_force(sim, 2)
+    if phase is not None:
+        assert out.hazardous > 0
+
+
+@pytest.mark.slow
+def test_articulated_counts_equal_brute_force_three_actions() -> None:
+    sim = _feature_sim("reach-near", 1.5)
+    out = decide(sim, 3, Bounds(sim, horizon=3))
+    assert out.decided and out.pruned_states.get("at-rest", 0) > 0
+    assert out.states[2] < 84 * 119  # states merged that differ in no slot the future reads (stance, arms too)
+    assert out.hazardous == brute_force(sim, 3) > 0

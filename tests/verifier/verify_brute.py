@@ -1,26 +1,25 @@
 """Brute force for the verifier's cross-checks: every action prefix played, none merged, none pruned.
 
-The tree of all 30^h sequences is walked layer by layer with the same compiled step the simulator plays
-(``expand_states``): a prefix's children are its state stepped by each action, an unsafe child ends its
-episode (all 30^r completions hazardous), and nothing else is assumed. Only the merging and the bounds of
-``verifier.tree`` are left out, which is what these checks test; the step itself is checked against
-``Simulator.run_batch`` elsewhere.
+The tree of all n^h sequences (n: the worker's actions per decision, 30 or 119) is walked layer by layer with
+the same compiled step the simulator plays (``expand_states``): a prefix's children are its state stepped by
+each action, an unsafe child ends its episode (all n^r completions hazardous), and nothing else is assumed.
+Only the merging and the bounds of ``verifier.tree`` are left out, which is what these checks test; the step
+itself is checked against ``Simulator.run_batch`` elsewhere.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from cellstress.human.actions import N_ACTIONS
 from cellstress.sim import layout as L
 from cellstress.sim.kernels.expand import expand_states
 
-CHUNK = 2048  # parents per expansion (memory: CHUNK * 30 children)
+CHUNK = 2048  # parents per expansion (memory: CHUNK * n children)
 
 
 def brute_force(sim, horizon: int) -> int:
     """The number of hazardous sequences of ``horizon`` actions from ``sim``'s start (its reset state)."""
-    n_act = N_ACTIONS
+    n_act = sim.n_actions
     s0 = sim.reset()
     if s0[L.S_UNSAFE] != 0.0:
         return n_act ** horizon

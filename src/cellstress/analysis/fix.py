@@ -4,7 +4,7 @@ A candidate is **kept** when the changed cell passes ``check`` (every row) and i
 
 * ``verify`` at the cell's horizon, ``--phases cell --moments grid`` (the cell's own arrival moments, grid
   moments only), one worker process, within ``time_limit`` seconds: PROVED-SAFE keeps it, UNSAFE drops it;
-* where verify cannot decide (UNDECIDED at the time limit, a horizon over verify's 12, the articulated worker):
+* where verify cannot decide (UNDECIDED at the time limit, a horizon over verify's 12):
   the search ``plan`` over ``budget`` episodes, ``--until budget --distinct`` with ``seed``: no hazard keeps it
   (a search is not a proof, and the row says "search").
 

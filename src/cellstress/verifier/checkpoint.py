@@ -23,15 +23,15 @@ from cellstress.core.errors import CellstressError
 from cellstress.core.fields import Record
 from cellstress.core.io import InputFileError, duplicate_json_key
 from cellstress.core.journal import JournalWriter, read_journal
-from cellstress.human.actions import N_ACTIONS
 from cellstress.searchers.result import validation_problem
 from cellstress.sim.records import Name
 from cellstress.verifier.records import Count, Subtree, VerifyOptions
+from cellstress.verifier.tree import MAX_ACTIONS
 
 CHECKPOINT = "verify-checkpoint.jsonl"
 MAX_CHECKPOINT_BYTES = 2**30  # a sub-tree's line is a few hundred bytes: millions of sub-trees
 KIND = "cellstress verify checkpoint"
-Action = Annotated[int, Field(ge=0, lt=N_ACTIONS)]
+Action = Annotated[int, Field(ge=0, lt=MAX_ACTIONS)]  # the cell's own count: read_checkpoint
 
 
 class CheckpointError(CellstressError):
@@ -86,9 +86,11 @@ def _parse(model, line: bytes, path: Path, n: int):
     return rec
 
 
-def read_checkpoint(path: Path, head: CheckpointHead, subtrees: list[tuple[str, float]]) -> dict[int, DecidedLine]:
-    """The sub-trees a checkpoint holds, by index (``subtrees``: each task's start point and phase, in order); an
-    empty dict when there is none. CheckpointError for one of another verification or a damaged one."""
+def read_checkpoint(path: Path, head: CheckpointHead, subtrees: list[tuple[str, float]], n_actions: int
+                    ) -> dict[int, DecidedLine]:
+    """The sub-trees a checkpoint holds, by index (``subtrees``: each task's start point and phase, in order;
+    ``n_actions``: the cell's worker's actions per decision); an empty dict when there is none. CheckpointError
+    for one of another verification or a damaged one."""
     try:
         lines, _ = read_journal(path, MAX_CHECKPOINT_BYTES)
     except InputFileError as exc:
@@ -104,6 +106,9 @@ def read_checkpoint(path: Path, head: CheckpointHead, subtrees: list[tuple[str, 
         if rec.task >= len(subtrees) or (rec.subtree.start, rec.subtree.phase) != subtrees[rec.task]:
             raise CheckpointError(f"{path}: line {n} is not a sub-tree of this verification; the file is damaged "
                                   "(remove it to start over)")
+        if any(a >= n_actions for f in rec.found for a in f.actions):
+            raise CheckpointError(f"{path}: line {n} holds an action this cell's worker does not have (it has "
+                                  f"{n_actions}); the file is damaged (remove it to start over)")
         if rec.subtree.undecided:
             raise CheckpointError(f"{path}: line {n} holds a sub-tree not decided whole; the file is damaged "
                                   "(remove it to start over)")

@@ -1,11 +1,15 @@
 """The distance bound: where the worker cannot come near anything the robot can occupy in the time left.
 
-**The worker.** Every point of the worker lies within ``radius`` of the hip pivot H = (x, y, hip height): the
-legs hang from it, the trunk, head and shoulders turn rigidly about it (``kernels.body.pose_body``), the arms
-hang from the shoulders and the reach volumes lie within the arm's length of them (fences only shorten a
-reach). The reach field is a grid, so ``REACH_SLACK`` grid spacings are added for its interpolation. H moves
-only when the worker walks, by one stride (walking speed x dt) per step at most; turning and bending do not move
-it.
+**The worker.** Every point of the worker lies within the kernel's radius of the hip pivot (x, y, hip height
+plus the stance's drop): the legs hang from it, the trunk, head and shoulders turn rigidly about it
+(``kernels.body.pose_body``; lying prone too), the arms hang or reach from the shoulders and the reach volumes
+lie within the arm's length of them (fences only shorten a reach). The reach field is a grid, so ``REACH_SLACK``
+grid spacings are added for its interpolation. The field is measured from H = (x, y, z_H): the articulated
+worker's stance moves the pivot between the lowest and the highest drop of its action table (prone to tiptoe),
+so z_H is the middle of that range and half the range is added to the radius (the paper's worker has no stance:
+z_H is its hip height, nothing is added). H moves only when the worker walks, side-steps, steps back or
+crawls, by at most one stride (walking speed x dt x the action table's largest walking fraction; crawling is
+slower) per step; turning, bending, a change of stance and the arms do not move it.
 
 **The robot.** Its pose is always its path's pose at the path time tau the state holds (``kernels.robot``:
 ``path_time``, ``live_path_time``), and tau advances at a rate sigma in [0, 1]: one second per second until a
@@ -34,6 +38,7 @@ from __future__ import annotations
 import numpy as np
 
 from cellstress.core.jit import njit, prange
+from cellstress.human.actions import A_DROP, A_WALK
 from cellstress.sim import layout as L
 from cellstress.sim.kernels.body import worker_radius as body_radius
 from cellstress.sim.kernels.robot import live_path_time, path_time
@@ -45,10 +50,32 @@ GRID = 0.05  # m: floor grid of the field
 SUB = 4  # robot samples per time step
 
 
-def worker_radius(body: np.ndarray, reach_spacing: float) -> float:
-    """A radius about the hip pivot that holds every point of the paper's worker, in every pose (see the module:
-    ``kernels.body.worker_radius``, the one the swept contact test uses too)."""
-    return float(body_radius(body, 0.0, reach_spacing))
+def drop_range(params) -> tuple[float, float]:
+    """The lowest and the highest the stance puts the hip pivot relative to standing [m] (0, 0 for the paper's
+    worker): the action table's drop targets, and standing itself, which every stance moves linearly between."""
+    drops = np.asarray(params.act[:, A_DROP], dtype=float)
+    return min(float(drops.min(initial=0.0)), 0.0), max(float(drops.max(initial=0.0)), 0.0)
+
+
+def field_height(params) -> float:
+    """z_H, the height the distance field is measured at: the middle of the pivot's heights (see the module)."""
+    low, high = drop_range(params)
+    return float(params.body[L.B_HIP_Z]) + (low + high) / 2.0
+
+
+def worker_radius(params) -> float:
+    """A radius about (x, y, z_H) that holds every point of the worker, in every pose and stance (see the module):
+    the kernel's radius about the hip pivot at the highest stance (``kernels.body.worker_radius``, the one the
+    swept contact test uses too), plus the farthest the stance takes the pivot from z_H."""
+    low, high = drop_range(params)
+    return float(body_radius(params.body, high, float(params.scal[L.C_REACH_H]))) + (high - low) / 2.0
+
+
+def worker_stride(params) -> float:
+    """The farthest the hip pivot's (x, y) moves in one time step: walking speed x dt x the largest walking
+    fraction of the worker's actions (crawling is slower still: ``kernels.step.move_worker``)."""
+    walks = np.abs(np.asarray(params.act[:, A_WALK], dtype=float)).max(initial=0.0)
+    return float(params.body[L.B_WALK_SPEED]) * float(params.scal[L.C_DT]) * float(walks)
 
 
 def robot_point_speed(layout, robot: int = 0) -> float:
@@ -68,9 +95,9 @@ class SweptField:
         # a step may count as unsafe up to this d_HR: the contact distance, or where the swept test between the
         # steps cannot rule a contact out (kernels.sweep.flag_distance)
         self.dtol = flag_distance(P) if P.scal[L.C_SWEEP] != 0.0 else float(P.scal[L.C_DTOL])
-        self.stride = float(P.body[L.B_WALK_SPEED]) * self.dt
-        self.radius = worker_radius(P.body, float(P.scal[L.C_REACH_H]))
-        self.hip = float(P.body[L.B_HIP_Z])
+        self.stride = worker_stride(P)
+        self.radius = worker_radius(P)
+        self.hip = field_height(P)
         steps = horizon * self.spa
         delta = self.dt / SUB
         tau0 = self.scal[:, L.C_PHASE0]

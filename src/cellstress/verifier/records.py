@@ -69,9 +69,10 @@ class ClassCount(Record):
 
 
 class Subtree(Record):
-    """One start point at one arrival phase: its verdict and exact counts (``sequences`` = 30^horizon) at that
-    phase; ``window``: the arrival moments within this many seconds of it are covered too (0: the phase alone),
-    by a model whose robot capsules were grown by up to ``margin`` m (``verifier.arrival``); ``confirmed``:
+    """One start point at one arrival phase: its verdict and exact counts (``sequences`` = n^horizon, n the
+    worker's actions per decision: 30 or 119) at that phase; ``window``: the arrival moments within this many
+    seconds of it are covered too (0: the phase alone), by a model whose robot capsules were grown by up to
+    ``margin`` m (``verifier.arrival``); ``confirmed``:
     sequences of that model hazardous at a moment of the window when replayed; ``alarms``: its other
     hazardous sequences, hazardous at none of the moments replayed (not a proof, not a hazard)."""
 

@@ -23,7 +23,6 @@ from cellstress.core.io import OutputPathError
 from cellstress.core.jit import numba
 from cellstress.core.ray_pool import import_ray, ray_map
 from cellstress.core.version import __version__
-from cellstress.human.actions import N_ACTIONS
 from cellstress.searchers.distinct import hazard_class, hazard_class_record, root_cause
 from cellstress.searchers.result import CellRef
 from cellstress.searchers.severity import worst_first
@@ -60,7 +59,7 @@ from cellstress.verifier.records import (
     Witness,
 )
 from cellstress.verifier.scope import build_scope
-from cellstress.verifier.tree import TreeOutcome, decide
+from cellstress.verifier.tree import MAX_ACTIONS, TreeOutcome, decide
 from cellstress.verifier.witness import witness_actions, witness_severity, write_witness
 
 WITNESS_DIR = "witness-{:02d}"
@@ -165,7 +164,7 @@ def decide_task(task: Task, progress: Callable[[int], None] | None = None) -> De
     exactly, and the window model's hazardous sequences are replayed across the window (``verifier.arrival``)."""
     opts = task.options
     if task.deadline is not None and time.time() > task.deadline:  # not begun: all of it undecided
-        total = N_ACTIONS ** opts.horizon
+        total = _simulator(task.cell).n_actions ** opts.horizon
         return Decided(Subtree(start=task.start.name, phase=task.phase, window=task.window, verdict=UNDECIDED,
                                sequences=total, hazardous=0, undecided=total, probability=0.0, states=(),
                                expanded=0, pruned=(), classes=()), ())
@@ -248,14 +247,14 @@ def run_verify(sim: Simulator, options: VerifyOptions, *, workers: int | None = 
     deadline = None if options.time_limit is None else time.time() + options.time_limit
     cover = arrival_cover(sim, sim.contacts is not None)
     tasks = tasks_of(sim, options, deadline, cover)
-    total = len(tasks) * N_ACTIONS ** options.horizon
+    total = len(tasks) * sim.n_actions ** options.horizon
     journal = None if out is None else Path(out) / CHECKPOINT
     head = head_of(cell.sha256, cell.spec.criterion.type, options, len(tasks), __version__)
     done: dict[int, Decided] = {}
     if journal is not None:
         journal.parent.mkdir(parents=True, exist_ok=True)
         done = {i: _decided(line) for i, line in
-                read_checkpoint(journal, head, [(t.start.name, t.phase) for t in tasks]).items()}
+                read_checkpoint(journal, head, [(t.start.name, t.phase) for t in tasks], sim.n_actions).items()}
         if done and resumed is not None:
             resumed(len(done), len(tasks))
     decided_sequences = [sum(d.subtree.sequences for d in done.values())]
@@ -320,7 +319,7 @@ def assemble(sim: Simulator, options: VerifyOptions, tasks: list[Task], decided:
             c = classes.get(f.key)
             if c is None:
                 c = classes[f.key] = {"task": task, "found": f, "sequences": 0}
-                c["actions"] = witness_actions(cell, task.start, f.phase, f.actions)
+                c["actions"] = witness_actions(sim, task.start, f.phase, f.actions)
                 c["severity"] = witness_severity(sim, c["actions"])
             c["sequences"] += f.sequences
     for i, c in enumerate(worst_first(list(classes.values()), key=lambda c: c["severity"])):
@@ -436,9 +435,8 @@ def verify_cell(sim: Simulator, *, horizon: int | None = None, phases: str = "al
         raise VerifyError(str(exc)) from None
     if out is not None:
         check_witness_folders(Path(out))
-    if sim.layout.worker.articulated:
-        # its bounds are the paper worker's (30 actions, reach volumes on rigid shoulders: docs/verify.md)
-        raise VerifyError(f"verify proves cells with the paper's worker only; this cell's is "
-                          f"{sim.cell.spec.human.model!r} (human.model)")
+    if sim.n_actions > MAX_ACTIONS:  # (no built-in worker has more: the paper's 30, the articulated 119)
+        raise VerifyError(f"verify decides at most {MAX_ACTIONS} actions per decision; this cell's worker has "
+                          f"{sim.n_actions} (human.model)")
     return run_verify(sim, options, workers=workers, out=out, progress=progress, static_failures=static_failures,
                       resumed=resumed, backend=backend, address=address)

@@ -34,12 +34,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cellstress.human.actions import N_ACTIONS
 from cellstress.sim import layout as L
 from cellstress.sim.kernels.expand import expand_states
 from cellstress.verifier.bounds import Bounds
 
-CHUNK = 8192  # parents per compiled expansion (bounds memory; the time limit and progress are checked between)
+CHILDREN = 8192 * 30  # children per compiled expansion (bounds memory; the time limit and progress are checked between)
+MAX_ACTIONS = 127  # actions per decision the witness prefixes (int8) can hold (the paper's 30, the articulated 119)
 
 
 @dataclass(frozen=True)
@@ -131,7 +131,8 @@ def decide(sim, horizon: int, bounds: Bounds, *, deadline: float | None = None,
     """Decide every sequence of ``horizon`` actions from ``sim``'s start (see the module). ``deadline``: a
     ``time.monotonic()`` after which the tree is left undecided; ``progress(sequences)`` is told how many more
     sequences each step decided; ``keep``: keep every layer's merged states, for ``lookup``."""
-    n_act = N_ACTIONS
+    n_act = sim.n_actions
+    chunk = max(1, CHILDREN // n_act)  # parents per expansion
     out = TreeOutcome(horizon, n_act ** horizon)
     judge = _Judge(sim)
     s0 = sim.reset()
@@ -148,11 +149,11 @@ def decide(sim, horizon: int, bounds: Bounds, *, deadline: float | None = None,
         t_layer = time.perf_counter()
         weight = n_act ** (horizon - depth)
         kept_states, kept_mult, kept_parent, kept_action = [], [], [], []
-        for i0 in range(0, len(states), CHUNK):
+        for i0 in range(0, len(states), chunk):
             if deadline is not None and time.monotonic() > deadline:
                 out.timed_out = True
                 return out
-            parents = states[i0:i0 + CHUNK]
+            parents = states[i0:i0 + chunk]
             n_child = len(parents) * n_act
             children = np.empty((n_child, L.NS))
             last = np.empty((n_child, L.NM))
@@ -160,7 +161,7 @@ def decide(sim, horizon: int, bounds: Bounds, *, deadline: float | None = None,
             expand_states(sim.params, parents, n_act, children, last, d_min)
             judge(parents, children, last, d_min, n_act)
             out.expanded += n_child
-            cmult = np.repeat(mult[i0:i0 + CHUNK], n_act)
+            cmult = np.repeat(mult[i0:i0 + chunk], n_act)
             unsafe = children[:, L.S_UNSAFE] != 0.0
             before = out.hazardous + out.safe
             for c in np.flatnonzero(unsafe):

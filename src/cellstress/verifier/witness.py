@@ -12,9 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from cellstress.cell.load import Cell
 from cellstress.core.version import __version__
-from cellstress.human.actions import ACTION_NAMES
 from cellstress.searchers import hazard_record
 from cellstress.searchers.result import FORMAT, CellRef, EpisodeRef, SearchResult, Severity, TopEpisode
 from cellstress.searchers.severity import severity
@@ -25,10 +23,11 @@ from cellstress.verifier.phases import StartPoint
 SEARCHER = "verify"  # the ``searcher`` of a witness's result file
 
 
-def witness_actions(cell: Cell, start: StartPoint, phase: float, actions: tuple[int, ...]) -> tuple[str, ...]:
-    """A witness's recorded actions: its start point (on a cell with several), its phase, its actions' names."""
-    head = (f"{START_PREFIX}{start.name}",) if cell.spec.human.starts else ()
-    return (*head, phase_token(phase), *(ACTION_NAMES[a] for a in actions))
+def witness_actions(sim, start: StartPoint, phase: float, actions: tuple[int, ...]) -> tuple[str, ...]:
+    """A witness's recorded actions: its start point (on a cell with several), its phase, its actions' names
+    (``sim``'s worker's: the paper's 30 or the articulated worker's)."""
+    head = (f"{START_PREFIX}{start.name}",) if sim.cell.spec.human.starts else ()
+    return (*head, phase_token(phase), *(sim.action_names[a] for a in actions))
 
 
 def witness_result(sim, actions: list[str], source: str) -> SearchResult:
