@@ -7,7 +7,8 @@ soundness argument; ``tests/verify/test_bounds.py`` checks the assumptions they 
 * ``at-rest``: every robot's latched stop has taken full effect: the robots stand for good, and the criterion's
   kernel test needs one to move.
 * ``distance``: the worker cannot come within the criterion's contact distance of anything the robot can occupy
-  in the time left (``verifier.reach``).
+  in the time left (``verifier.reach``); in the last layer, where the action is known, no pose of that action
+  can (``verifier.last_action``: ``last_safe``).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from cellstress.sim import layout as L
+from cellstress.verifier.last_action import LastAction, applies
 from cellstress.verifier.reach import SweptField
 
 AT_REST = "at-rest"
@@ -52,6 +54,8 @@ class Bounds:
         # without a kernel test is shown only the rows within it, Simulator.first_unsafe): the distance bound holds
         # for all of them.
         self.swept = SweptField(sim, horizon) if DISTANCE in enabled else None
+        # the same argument in the last layer, where the action is known (verifier.last_action)
+        self.last = LastAction(sim, self.swept) if self.swept is not None and applies(sim) else None
 
     def prune(self, children: np.ndarray, last: np.ndarray, alive: np.ndarray, left: int
               ) -> Iterator[tuple[str, np.ndarray]]:
@@ -66,3 +70,8 @@ class Bounds:
             yield AT_REST, alive & rest
         if self.swept is not None:
             yield DISTANCE, alive & self.swept.safe(children, left * self.spa)
+
+    def last_safe(self, parents: np.ndarray) -> np.ndarray | None:
+        """(parents, actions): the last layer's children the distance bound proves safe before they are played,
+        or None where it has no last-action bound (the articulated worker, or the bound not enabled)."""
+        return None if self.last is None else self.last.safe(parents)

@@ -111,11 +111,15 @@ class SweptField:
         nx = int(np.ceil((fl[1] - fl[0]) / GRID)) + 1
         ny = int(np.ceil((fl[3] - fl[2]) / GRID)) + 1
         self.samples = np.empty((len(self.scal), n, nx, ny))
+        # each robot's capsule axes at every sample, their radii, and how far a capsule point moves between a
+        # sample and the next half-way (kept for the last action's bound, verifier.last_action)
+        self.robots: list[tuple[np.ndarray, np.ndarray, np.ndarray, float]] = []
         for r in range(len(self.scal)):
             own = np.flatnonzero(P.cap_robot == r)
-            _sample_field(np.ascontiguousarray(ra[:, own]), np.ascontiguousarray(rb[:, own]),
-                          np.ascontiguousarray(P.cap_r[own]), self.x0, self.y0, GRID, self.hip, self.samples[r])
-            self.samples[r] -= robot_point_speed(sim.layout, r) * delta / 2.0 + GRID * np.sqrt(0.5)
+            self.robots.append((np.ascontiguousarray(ra[:, own]), np.ascontiguousarray(rb[:, own]),
+                                np.ascontiguousarray(P.cap_r[own]), robot_point_speed(sim.layout, r) * delta / 2.0))
+            _sample_field(*self.robots[r][:3], self.x0, self.y0, GRID, self.hip, self.samples[r])
+            self.samples[r] -= self.robots[r][3] + GRID * np.sqrt(0.5)
 
     def lower_bound(self, states: np.ndarray, steps_left: int) -> np.ndarray:
         """A lower bound, over the next ``steps_left`` steps after each of ``states``, on the distance from the
@@ -135,27 +139,33 @@ class SweptField:
         return self.lower_bound(children, steps_left) - self.radius > self.dtol
 
 
+@njit(cache=True, inline="always")
+def window_start(scal, states, c, r, dt, sub):
+    """Robot r's path time in state c less its phase, counted in samples of dt / sub (an exact whole number on
+    the plain path before a stop). Only robot 0 leaves the plain path model (``S_LIVE``); the others stop for
+    good."""
+    k = states[c, L.S_K]
+    t = k * dt
+    t_stop = states[c, L.S_TSTOP] if r == 0 else states[c, L.S_XTSTOP + r - 1]
+    if r == 0 and states[c, L.S_LIVE] != 0.0:
+        return (live_path_time(scal[r], states[c], t)[0] - scal[r, L.C_PHASE0]) / (dt / sub)
+    if t < t_stop:
+        return k * sub  # (path_time: its phase + t)
+    return (path_time(scal[r], t, t_stop)[0] - scal[r, L.C_PHASE0]) / (dt / sub)
+
+
 @njit(cache=True)
 def _window_bound(samples, x0, y0, g, sub, dt, scal, steps_left, stride, states, out):
     """``SweptField.lower_bound``: out[c] = min over robots r and j in 1..steps_left of (least value of robot r's
     samples at the hip pivot's grid node from its path time tau_c to tau_c + j dt, one more each side) -
-    j * stride; tau_c robot r's path time in state c, counted in samples (an exact whole number on the plain
-    path before a stop). Only robot 0 leaves the plain path model (``S_LIVE``); the others stop for good."""
+    j * stride; tau_c robot r's path time in state c, counted in samples (``window_start``)."""
     nx, ny, n = samples.shape[2], samples.shape[3], samples.shape[1]
     for c in range(states.shape[0]):
-        k = states[c, L.S_K]
-        t = k * dt
         ix = min(max(int(np.rint((states[c, L.S_X] - x0) / g)), 0), nx - 1)
         iy = min(max(int(np.rint((states[c, L.S_Y] - y0) / g)), 0), ny - 1)
         best = np.inf
         for r in range(samples.shape[0]):
-            t_stop = states[c, L.S_TSTOP] if r == 0 else states[c, L.S_XTSTOP + r - 1]
-            if r == 0 and states[c, L.S_LIVE] != 0.0:
-                start = (live_path_time(scal[r], states[c], t)[0] - scal[r, L.C_PHASE0]) / (dt / sub)
-            elif t < t_stop:
-                start = k * sub  # (path_time: its phase + t)
-            else:
-                start = (path_time(scal[r], t, t_stop)[0] - scal[r, L.C_PHASE0]) / (dt / sub)
+            start = window_start(scal, states, c, r, dt, sub)
             run = np.inf
             i = max(0, int(np.floor(start)) - 1)
             for j in range(1, steps_left + 1):

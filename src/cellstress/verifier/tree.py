@@ -35,8 +35,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cellstress.sim import layout as L
-from cellstress.sim.kernels.expand import expand_states
-from cellstress.verifier.bounds import Bounds
+from cellstress.sim.kernels.expand import expand_pairs, expand_states
+from cellstress.verifier.bounds import DISTANCE, Bounds
 
 CHILDREN = 8192 * 30  # children per compiled expansion (bounds memory; the time limit and progress are checked between)
 MAX_ACTIONS = 127  # actions per decision the witness prefixes (int8) can hold (the paper's 30, the articulated 119)
@@ -117,11 +117,11 @@ class _Judge:
         self.active = sim.contacts is not None
         self.dtol = sim.criterion.distance_tolerance
 
-    def __call__(self, parents, children, last, d_min, n_act):
+    def __call__(self, parents, children, last, d_min, parent, action):
         if not self.active:
             return
         for c in np.flatnonzero(d_min <= self.dtol):
-            nxt, rows = self.sim.step(parents[c // n_act], int(c % n_act))
+            nxt, rows = self.sim.step(parents[parent[c]], int(action[c]))
             children[c] = nxt
             last[c] = rows[-1]
 
@@ -154,20 +154,32 @@ def decide(sim, horizon: int, bounds: Bounds, *, deadline: float | None = None,
                 out.timed_out = True
                 return out
             parents = states[i0:i0 + chunk]
-            n_child = len(parents) * n_act
+            pmult = mult[i0:i0 + chunk]
+            before = out.hazardous + out.safe
+            clear = bounds.last_safe(parents) if depth == horizon else None
+            if clear is None:  # every child, numbered parent * n_act + action
+                n_child = len(parents) * n_act
+                parent = np.repeat(np.arange(len(parents)), n_act)
+                action = np.tile(np.arange(n_act), len(parents))
+            else:  # the last layer: the children the bound does not clear (still in prefix order)
+                _count_cut(out, pmult, clear)
+                parent, action = np.nonzero(~clear)
+                n_child = len(parent)
             children = np.empty((n_child, L.NS))
             last = np.empty((n_child, L.NM))
             d_min = np.empty(n_child)
-            expand_states(sim.params, parents, n_act, children, last, d_min)
-            judge(parents, children, last, d_min, n_act)
+            if clear is None:
+                expand_states(sim.params, parents, n_act, children, last, d_min)
+            else:
+                expand_pairs(sim.params, parents, parent, action, children, last, d_min)
+            judge(parents, children, last, d_min, parent, action)
             out.expanded += n_child
-            cmult = np.repeat(mult[i0:i0 + chunk], n_act)
+            cmult = pmult[parent]
             unsafe = children[:, L.S_UNSAFE] != 0.0
-            before = out.hazardous + out.safe
             for c in np.flatnonzero(unsafe):
                 seqs = int(cmult[c]) * weight
                 out.hazardous += seqs
-                acts = (*prefixes[i0 + c // n_act].tolist(), int(c % n_act))
+                acts = (*prefixes[i0 + parent[c]].tolist(), int(action[c]))
                 out.hits.append(Hit(tuple(acts), children[c].copy(), last[c].copy(), seqs))
             alive = ~unsafe
             if depth == horizon:
@@ -184,8 +196,8 @@ def decide(sim, horizon: int, bounds: Bounds, *, deadline: float | None = None,
                 idx = np.flatnonzero(alive)
                 kept_states.append(children[idx])
                 kept_mult.append(cmult[idx])
-                kept_parent.append(i0 + idx // n_act)
-                kept_action.append((idx % n_act).astype(np.int8))
+                kept_parent.append(i0 + parent[idx])
+                kept_action.append(action[idx].astype(np.int8))
             _tell(progress, out.hazardous + out.safe - before)
         if depth == horizon:
             out.seconds.append(time.perf_counter() - t_layer)
@@ -203,6 +215,17 @@ def decide(sim, horizon: int, bounds: Bounds, *, deadline: float | None = None,
     return out
 
 
+def _count_cut(out: TreeOutcome, pmult: np.ndarray, clear: np.ndarray) -> None:
+    """Count the last layer's children the distance bound cleared before play (``Bounds.last_safe``) as safe."""
+    per_parent = clear.sum(axis=1)
+    n_cut = int(per_parent.sum())
+    if n_cut:
+        seqs = sum(int(m) * int(k) for m, k in zip(pmult, per_parent, strict=True) if k)
+        out.safe += seqs
+        out.pruned_states[DISTANCE] = out.pruned_states.get(DISTANCE, 0) + n_cut
+        out.pruned_sequences[DISTANCE] = out.pruned_sequences.get(DISTANCE, 0) + seqs
+
+
 def lookup(sim, out: TreeOutcome, bounds: Bounds, actions) -> str:
     """How a kept tree (``decide(..., keep=True)``) counted the sequence ``actions``: ``hazardous``, ``safe`` or
     ``pruned:BOUND``. It follows the sequence through the merged states, as the counting did: the state after
@@ -211,6 +234,10 @@ def lookup(sim, out: TreeOutcome, bounds: Bounds, actions) -> str:
     if state[L.S_UNSAFE] != 0.0:
         return "hazardous"
     for depth, a in enumerate(actions, start=1):
+        if depth == out.horizon:
+            clear = bounds.last_safe(state[None, :])
+            if clear is not None and clear[0, sim.action_index(a)]:
+                return f"pruned:{DISTANCE}"
         child, rows = sim.step(state, a)
         if child[L.S_UNSAFE] != 0.0:
             return "hazardous"

@@ -19,12 +19,11 @@ EXPAND_CHUNK = 64  # children per work-array set in expand_states
 
 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
-def _expand_one(P, states, n_act, c, W, state, rows, children, last, d_min):
-    """Child c = (parent c // n_act, action c % n_act), on the given work arrays."""
-    p = c // n_act
+def _expand_one(P, states, p, a, c, W, state, rows, children, last, d_min):
+    """Child c = states[p] after action a, on the given work arrays."""
     for i in range(state.shape[0]):
         state[i] = states[p, i]
-    n = step_action(P, state, np.int64(c % n_act), W, rows, np.int64(0))
+    n = step_action(P, state, np.int64(a), W, rows, np.int64(0))
     for i in range(state.shape[0]):
         children[c, i] = state[i]
     lo = np.inf
@@ -51,4 +50,19 @@ def expand_states(P, states, n_act, children, last, d_min):
         state = np.empty(NS)
         rows = np.empty((spa, NM))
         for c in range(chunk * EXPAND_CHUNK, min(n_child, (chunk + 1) * EXPAND_CHUNK)):
-            _expand_one(P, states, n_act, c, W, state, rows, children, last, d_min)
+            _expand_one(P, states, c // n_act, c % n_act, c, W, state, rows, children, last, d_min)
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def expand_pairs(P, states, parent, action, children, last, d_min):
+    """children[i]: states[parent[i]] after action[i]; last and d_min as for ``expand_states`` (the children a
+    bound could not clear, in any order)."""
+    n_child = parent.shape[0]
+    spa = P.spa
+    n_chunks = (n_child + EXPAND_CHUNK - 1) // EXPAND_CHUNK
+    for chunk in prange(n_chunks):
+        W = make_work(P)
+        state = np.empty(NS)
+        rows = np.empty((spa, NM))
+        for c in range(chunk * EXPAND_CHUNK, min(n_child, (chunk + 1) * EXPAND_CHUNK)):
+            _expand_one(P, states, parent[c], action[c], c, W, state, rows, children, last, d_min)
