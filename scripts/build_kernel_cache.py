@@ -66,7 +66,7 @@ COMMANDS = [
     ["verify", "baseline", "--horizon", "2", "--out", "{out}/v"],
     # a last layer that is reached (verifier.last_action, expand_pairs): baseline's and two-robots' trees end after
     # their first action
-    ["verify", "s3-fence-gap", "--horizon", "2", "--phases", "cell", "--out", "{out}/v3"],
+    ["verify", "s3-fence-gap", "--horizon", "3", "--phases", "cell", "--out", "{out}/v3"],
     ["search", "s2-elbow-intrusion", "--searcher", "evolve", "--budget", "30", "--seed", "0", "--set", "score=all",
      "--out", "{out}/la"],
     ["@scripts/curtain_probe.py", "s2-elbow-intrusion", "--step", "0.25"],  # analysis.probe

@@ -22,7 +22,8 @@ from cellstress.core.jit import caching, numba
 ROOT = Path(__file__).resolve().parents[2]
 SRC = ROOT / "src" / "cellstress"
 
-# In a fresh interpreter: build a simulator and run what a first search runs, and count numba's compiles of
+# In a fresh interpreter: build a simulator and run what a first search and a small verify tree run, and count
+# numba's compiles of
 # cellstress's own functions (numba's helpers for typed lists etc. are not in the archive's scope).
 CHILD = r"""
 import json, sys
@@ -44,6 +45,9 @@ s = Simulator("s3-fence-gap")
 s.run_batch(np.zeros((4, 8), dtype=np.int64))
 s.step(s.reset(), 0)
 s.worker_paths(np.zeros((2, 8), dtype=np.int64))
+from cellstress.verifier.bounds import Bounds
+from cellstress.verifier.tree import decide
+assert decide(s, 3, Bounds(s, horizon=3)).pruned_states["distance"]  # a last layer reached (verifier.last_action)
 from numba.core import config
 print(json.dumps({"shipped": jit.USE_SHIPPED, "cpu": config.CPU_NAME, "compiled": compiled}))
 """
