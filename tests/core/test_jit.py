@@ -23,8 +23,8 @@ ROOT = Path(__file__).resolve().parents[2]
 SRC = ROOT / "src" / "cellstress"
 
 # In a fresh interpreter: build a simulator and run what a first search and a small verify tree run, and count
-# numba's compiles of
-# cellstress's own functions (numba's helpers for typed lists etc. are not in the archive's scope).
+# numba's compiles of cellstress's own functions (numba's helpers for typed lists etc. are not in the archive's
+# scope).
 CHILD = r"""
 import json, sys
 from cellstress.core import jit
