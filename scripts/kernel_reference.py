@@ -1,11 +1,11 @@
 """Record the simulator's outputs as raw bits, or check that the current code reproduces them exactly.
 
-    python scripts/kernel_reference.py record FILE.npz [--episodes 20000]
+    python scripts/kernel_reference.py record FILE.npz [--episodes 20000] [--cells all | NAME ...]
     python scripts/kernel_reference.py check FILE.npz
     python scripts/kernel_reference.py compare OLD.npz NEW.npz
 
-For each built-in reference cell: every ``run_batch`` output for random actions (numpy Generator, seed 123),
-200 whole traces (``Simulator.run``), 300 episodes played through ``Simulator.step``, s0 and its metric row.
+For each reference cell (the paper's four unless ``--cells`` names others; ``all``: every built-in cell):
+every ``run_batch`` output for random actions (numpy Generator, seed 123), 200 whole traces (``Simulator.run``), 300 episodes played through ``Simulator.step``, s0 and its metric row.
 Use it around a speed change that must not change results: record before, check after (exit 1 on any
 difference, which it lists). Around a change that may move d_HR within the trace's tolerance, record before
 and after and ``compare``: per cell, whether the unsafe episodes and steps are the same, how far d_HR moved
@@ -23,11 +23,16 @@ import numpy as np
 CELLS = ("baseline", "s1-scanner-width", "s2-elbow-intrusion", "s3-fence-gap")
 
 
-def outputs(episodes: int) -> dict[str, np.ndarray]:
+def cells_of(recording) -> list[str]:
+    """The cells a recording holds, in the order recorded."""
+    return list(dict.fromkeys(k.split(":")[0] for k in recording))
+
+
+def outputs(episodes: int, cells=CELLS) -> dict[str, np.ndarray]:
     from cellstress.sim.simulator import Simulator
 
     out: dict[str, np.ndarray] = {}
-    for c in CELLS:
+    for c in cells:
         sim = Simulator(c)
         acts = np.random.default_rng(123).integers(0, 30, size=(episodes, sim.actions_per_episode))
         r = sim.run_batch(acts)
@@ -64,7 +69,7 @@ def compare(old: dict, new: dict) -> int:
     from cellstress.sim import layout as L
 
     changed_outcome = False
-    for c in CELLS:
+    for c in cells_of(old):
         same_unsafe = np.array_equal(old[f"{c}:unsafe_step"], new[f"{c}:unsafe_step"])
         a, b = old[f"{c}:d_end"], new[f"{c}:d_end"]
         ok = np.isfinite(a) & np.isfinite(b)
@@ -95,9 +100,12 @@ def main(argv=None) -> int:
     ap.add_argument("file")
     ap.add_argument("new", nargs="?", help="compare: the second recording")
     ap.add_argument("--episodes", type=int, default=20_000)
+    ap.add_argument("--cells", nargs="+", default=list(CELLS), help="record: cells by name, or all built-in ones")
     args = ap.parse_args(argv)
     if args.mode == "record":
-        out = outputs(args.episodes)
+        from cellstress.cell.load import BUILTIN_CELLS
+
+        out = outputs(args.episodes, BUILTIN_CELLS if args.cells == ["all"] else args.cells)
         np.savez(args.file, **out)
         print(f"recorded {len(out)} arrays in {args.file}")
         return 0
@@ -106,8 +114,8 @@ def main(argv=None) -> int:
             ap.error("compare needs OLD.npz NEW.npz")
         return compare(np.load(args.file), np.load(args.new))
     ref = np.load(args.file)
-    n = len(ref["baseline:d_end"])
-    out = outputs(n)
+    cells = cells_of(ref)
+    out = outputs(len(ref[f"{cells[0]}:d_end"]), cells)
     bad = [k for k in ref.files if k not in out or not same_bits(ref[k], out[k])]
     for k in bad[:20]:
         print("differs:", k)

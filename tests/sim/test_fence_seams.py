@@ -15,46 +15,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from walls import every_panel_near, random_wall, sides
 
 from cellstress.cell.load import builtin_file, parse_cell
 from cellstress.sim.kernels.fences import fence_detour, fence_detour_bound
 from cellstress.sim.simulator import Simulator
 
 
-def _wall(rng, pieces: int) -> tuple[np.ndarray, np.ndarray]:
-    """A random straight wall as one panel and as ``pieces`` collinear panels meeting end to end."""
-    a = rng.uniform(-2.0, 2.0, 2)
-    ang = rng.uniform(0.0, 2 * np.pi)
-    length = rng.uniform(0.5, 3.0)
-    u = np.array([np.cos(ang), np.sin(ang)])
-    bottom, top = rng.choice([0.0, 0.0, 0.3]), rng.uniform(1.0, 2.4)
-    cuts = np.sort(rng.uniform(0.1, 0.9, pieces - 1))
-    ts = np.concatenate(([0.0], cuts, [1.0]))
-    pts = [a + t * length * u for t in ts]
-    whole = np.array([[*pts[0], *pts[-1], bottom, top]])
-    split = np.array([[*p, *q, bottom, top] for p, q in zip(pts, pts[1:], strict=False)])
-    return whole, split
-
-
 def _detour(fences, s, q):
-    near = np.arange(len(fences), dtype=np.int64)
-    return fence_detour(fences, near, np.int64(len(fences)), *s, *q, np.inf)
+    return fence_detour(fences, *every_panel_near(fences), *s, *q, np.inf)
 
 
 def _detour_bound(fences, s, q):
-    near = np.arange(len(fences), dtype=np.int64)
-    return fence_detour_bound(fences, near, np.int64(len(fences)), *s, *q, np.inf)
-
-
-def _sides(rng, whole):
-    """A shoulder on one side of the wall's line and a point on the other, near it."""
-    x0, y0, x1, y1 = whole[0, :4]
-    u = np.array([x1 - x0, y1 - y0])
-    n = np.array([-u[1], u[0]]) / np.linalg.norm(u)
-    along = np.array([x0, y0]) + rng.uniform(-0.2, 1.2) * u
-    s = np.array([*(along + rng.uniform(0.05, 0.6) * n), rng.uniform(0.8, 1.7)])
-    q = np.array([*(along + rng.uniform(-0.3, 0.3) * u - rng.uniform(0.05, 0.8) * n), rng.uniform(0.3, 1.8)])
-    return s, q
+    return fence_detour_bound(fences, *every_panel_near(fences), *s, *q, np.inf)
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -64,8 +37,8 @@ def test_a_split_wall_is_as_long_a_way_round_as_the_whole(seed):
     rng = np.random.default_rng(seed)
     checked = 0
     for _ in range(300):
-        whole, split = _wall(rng, int(rng.integers(2, 5)))
-        s, q = _sides(rng, whole)
+        whole, split = random_wall(rng, int(rng.integers(2, 5)))
+        s, q = sides(rng, whole)
         d_whole, d_split = _detour(whole, s, q), _detour(split, s, q)
         assert d_split == pytest.approx(d_whole, rel=1e-9, abs=1e-9), (whole, split, s, q)
         # the lower bound sees one wall too (a bound that went round the seam would be far below the length,
@@ -83,14 +56,14 @@ def test_a_panel_lying_in_a_wall_changes_nothing(seed):
     rng = np.random.default_rng(200 + seed)
     checked = 0
     for _ in range(300):
-        whole, _ = _wall(rng, 2)
+        whole, _ = random_wall(rng, 2)
         x0, y0, x1, y1 = whole[0, :4]
         a, b = np.sort(rng.uniform(0.05, 0.95, 2))
         inner = [x0 + a * (x1 - x0), y0 + a * (y1 - y0), x0 + b * (x1 - x0), y0 + b * (y1 - y0)]
         if rng.random() < 0.5:
             inner = inner[2:] + inner[:2]
         both = np.array([whole[0], [*inner, whole[0, 4], whole[0, 5]]])
-        s, q = _sides(rng, whole)
+        s, q = sides(rng, whole)
         d_whole, d_both = _detour_bound(whole, s, q), _detour_bound(both, s, q)
         assert d_both[0] == pytest.approx(d_whole[0], rel=1e-9, abs=1e-9), (both, s, q)
         assert d_both[1] <= d_both[0] + 1e-9
@@ -105,10 +78,10 @@ def test_the_bound_stays_below_the_length_where_runs_differ_in_height(seed):
     rng = np.random.default_rng(100 + seed)
     stepped = 0
     for _ in range(400):
-        whole, split = _wall(rng, int(rng.integers(2, 5)))
+        whole, split = random_wall(rng, int(rng.integers(2, 5)))
         split[:, 4] = rng.choice([0.0, 0.0, 0.2, 0.4], len(split))
         split[:, 5] = rng.uniform(0.9, 2.2, len(split))
-        s, q = _sides(rng, whole)
+        s, q = sides(rng, whole)
         d, lb = _detour_bound(split, s, q)
         assert lb <= d + 1e-9, (split, s, q)
         assert lb >= np.linalg.norm(s - q) - 1e-9
@@ -151,8 +124,9 @@ def _with_midpoints(text: str) -> str:
     data = yaml.safe_load(text)
     for fence in data["fences"]:
         pts = fence["points"]
-        fence["points"] = [pts[0]] + [p for a, b in zip(pts, pts[1:], strict=False)
-                                      for p in ([(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0], b)]
+        fence["points"] = [pts[0]] + [
+            p for a, b in zip(pts, pts[1:], strict=False) for p in ([(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0], b)
+        ]
     return yaml.safe_dump(data, sort_keys=False)
 
 
@@ -176,13 +150,16 @@ def test_a_wall_drawn_three_ways_is_one_wall():
     seams), the wall as one run with that panel lying in it, and the wall as one run alone give the same 300
     random episodes (the old rule let the arm through the first two in nearly every episode)."""
     text = Path(builtin_file("door-locked")).read_text()
-    door = text[text.index("  - type: guard-door"):text.index("human:")]
-    left, right = ("  - {points: [[-1.5, 3.2], [-1.5, -1.6], [-0.6, -1.6]], top: 2.0}",
-                   "  - {points: [[1.5, 3.2], [1.5, -1.6], [0.6, -1.6]], top: 2.0}")
+    door = text[text.index("  - type: guard-door") : text.index("human:")]
+    left, right = (
+        "  - {points: [[-1.5, 3.2], [-1.5, -1.6], [-0.6, -1.6]], top: 2.0}",
+        "  - {points: [[1.5, 3.2], [1.5, -1.6], [0.6, -1.6]], top: 2.0}",
+    )
     panel = "  - {points: [[-0.6, -1.6], [0.6, -1.6]], top: 2.0}\n"
     seams = text.replace(door, "").replace("devices:\n", "devices: []\n").replace("fences:\n", "fences:\n" + panel, 1)
     overlap = seams.replace(left, left.replace("[-0.6, -1.6]", "[1.5, -1.6]")).replace(
-        right, "  - {points: [[1.5, 3.2], [1.5, -1.6]], top: 2.0}")
+        right, "  - {points: [[1.5, 3.2], [1.5, -1.6]], top: 2.0}"
+    )
     single = overlap.replace(panel, "", 1)
     assert len({seams, overlap, single}) == 3
     sims = [Simulator(parse_cell(t, "door-locked (walls)", None)) for t in (seams, overlap, single)]

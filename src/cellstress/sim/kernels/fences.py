@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from cellstress.core.jit import njit
-from cellstress.sim.geometry import NO_REFCOUNT, point_segment_2d
+from cellstress.sim.geometry import NO_REFCOUNT, point_segment_2d, segment_segment_xyz
 
 # m: two panel ends this close meet, and a panel whose direction is off another's by at most this (as a sine)
 # continues it in a straight line. Such a seam is closed: the hand passes neither through it nor round it.
@@ -23,7 +23,8 @@ def near_fences(P, W, margin):
 def collect_near_fences(fences, sh, near, margin):
     """The panels within ``margin`` of either shoulder (plan view), and every panel that continues one of
     them in a straight line (``_continues``): a wall of collinear runs is near as a whole, so the hand's way
-    round it is the way round the wall, wherever its seams lie."""
+    round it is the way round the wall, wherever its seams lie. Their count; ``near`` (of ``params.near_size``) also
+    holds which near panel continues each of them at each end (``continuation``)."""
     n = 0
     for f in range(fences.shape[0]):
         x0, y0, x1, y1 = fences[f, 0], fences[f, 1], fences[f, 2], fences[f, 3]
@@ -37,20 +38,33 @@ def collect_near_fences(fences, sh, near, margin):
 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
 def _add_continuations(fences, near, n):
-    """Append to ``near[:n]`` every panel that continues one of them in a straight line; the new count."""
+    """Append to ``near[:n]`` every panel that continues one of them in a straight line; the new count. For each
+    near panel i and end e, ``near[_link(fences, i, e)]`` is 2 m + far for the first near panel ``near[m]`` that
+    continues i there (far: which of its ends lies away from i), -1 for none."""
     k = 0
     while k < n:
+        i = near[k]
         for end in range(2):
+            link = -1
             for j in range(fences.shape[0]):
-                if _continues(fences, near[k], end, j) >= 0:
-                    seen = False
-                    for m in range(n):
-                        seen = seen or near[m] == j
-                    if not seen:
+                far = _continues(fences, i, end, j)
+                if far >= 0:
+                    m = 0
+                    while m < n and near[m] != j:
+                        m += 1
+                    if m == n:
                         near[n] = j
                         n += 1
+                    if link < 0 or m < link >> 1:
+                        link = 2 * m + far
+            near[_link(fences, i, end)] = link
         k += 1
     return n
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _link(fences, i, end):
+    return fences.shape[0] + 1 + 2 * i + end
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -114,15 +128,15 @@ def _continues(fences, i, end, j):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def continuation(fences, near, n_near, i, end):
-    """(m, far): the near panel ``near[m]`` that continues panel i in a straight line past its end ``end``
-    and which of its ends lies away from i (``_continues``); (-1, 0) if none does. Fence runs that meet end
-    to end make one wall: the way round is past the wall's ends, not past the seam. The near panels hold
-    every panel that continues one of them (``collect_near_fences``), so the whole wall is there."""
-    for m in range(n_near):
-        far = _continues(fences, i, end, near[m])
-        if far >= 0:
-            return m, far
-    return -1, 0
+    """(m, far): the near panel ``near[m]`` that continues the near panel i in a straight line past its end
+    ``end`` and which of its ends lies away from i (``_continues``); (-1, 0) if none does. Fence runs that meet
+    end to end make one wall: the way round is past the wall's ends, not past the seam. The near panels hold
+    every panel that continues one of them, and which one does (``collect_near_fences``), so the whole wall is
+    there. (The first such near panel, should two continue i at one end.)"""
+    link = near[_link(fences, i, end)]
+    if link < 0:
+        return -1, 0
+    return link >> 1, link & 1
 
 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
@@ -150,35 +164,48 @@ def _panel_edges(fences, i, sx, sy, sz, qx, qy, qz):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _vertical_detour(sx, sy, sz, qx, qy, qz, x, y, z0, z1):
-    """The shortest path s -> e -> q with e on the vertical edge at (x, y) from height z0 up to z1."""
-    return _edge_detour(sx, sy, sz, qx, qy, qz, x, y, z0, 0.0, 0.0, 1.0, z1 - z0)[0]
+def _edge_term(sx, sy, sz, ax, ay, az, bx, by, bz, seg, ex, ey, ez, dx, dy, dz, length):
+    """No path from s through the edge (ex, ey, ez) + t d, t in [0, length], to the target is shorter. The
+    target is the point a (``seg`` False: the exact shortest such path, ``_edge_detour``) or any point of the
+    segment ab (``seg`` True: |s - edge| + |edge - ab|, a lower bound). (``seg`` is a constant at every call,
+    so each inlined copy keeps one branch.)"""
+    if not seg:
+        return _edge_detour(sx, sy, sz, ax, ay, az, ex, ey, ez, dx, dy, dz, length)[0]
+    fx, fy, fz = ex + length * dx, ey + length * dy, ez + length * dz
+    d_s = segment_segment_xyz(ex, ey, ez, fx, fy, fz, sx, sy, sz, sx, sy, sz)[0]
+    d_q = segment_segment_xyz(ex, ey, ez, fx, fy, fz, ax, ay, az, bx, by, bz)[0]
+    return np.sqrt(d_s) + np.sqrt(d_q)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _level_detour(fences, i, col, sx, sy, sz, qx, qy, qz):
-    """The shortest path s -> e -> q with e on panel i's horizontal edge at height fences[i, col] (5: the
-    top, 4: the bottom)."""
+def _vertical_detour(sx, sy, sz, ax, ay, az, bx, by, bz, seg, x, y, z0, z1):
+    """``_edge_term`` for the vertical edge at (x, y) from height z0 up to z1."""
+    return _edge_term(sx, sy, sz, ax, ay, az, bx, by, bz, seg, x, y, z0, 0.0, 0.0, 1.0, z1 - z0)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _level_detour(fences, i, col, sx, sy, sz, ax, ay, az, bx, by, bz, seg):
+    """``_edge_term`` for panel i's horizontal edge at height fences[i, col] (5: the top, 4: the bottom)."""
     ux, uy = fences[i, 2] - fences[i, 0], fences[i, 3] - fences[i, 1]
     w = np.sqrt(ux * ux + uy * uy)
-    return _edge_detour(sx, sy, sz, qx, qy, qz, fences[i, 0], fences[i, 1], fences[i, col], ux / w, uy / w, 0.0,
-                        w)[0]
+    return _edge_term(sx, sy, sz, ax, ay, az, bx, by, bz, seg, fences[i, 0], fences[i, 1], fences[i, col], ux / w,
+                      uy / w, 0.0, w)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _bottom_detour(fences, i, sx, sy, sz, qx, qy, qz):
+def _bottom_detour(fences, i, sx, sy, sz, ax, ay, az, bx, by, bz, seg):
     """``_level_detour`` over panel i's bottom edge where that edge counts (see ``_around_panel``), else inf."""
-    if fences[i, 4] < min(sz, qz):
+    if fences[i, 4] < min(sz, az, bz):
         return np.inf
-    return _level_detour(fences, i, 4, sx, sy, sz, qx, qy, qz)
+    return _level_detour(fences, i, 4, sx, sy, sz, ax, ay, az, bx, by, bz, seg)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _past_end(fences, near, n_near, i, end, sx, sy, sz, qx, qy, qz, own):
-    """A lower bound on the paths s -> q that cross the wall's plane beyond panel i's end ``end``, given the
-    detour ``own`` round that end edge: ``own`` where no panel continues i there; else the least detour
-    over the border of the wall the continuing panels make with i (their top and bottom edges, the steps
-    where two of them differ in height, the last one's far end edge)."""
+def _past_end(fences, near, n_near, i, end, sx, sy, sz, ax, ay, az, bx, by, bz, seg, own):
+    """A lower bound on the paths from s to the target (``_edge_term``) that cross the wall's plane beyond
+    panel i's end ``end``, given the term ``own`` of that end edge: ``own`` where no panel continues i there;
+    else the least term over the border of the wall the continuing panels make with i (their top and bottom
+    edges, the steps where two of them differ in height, the last one's far end edge)."""
     best = np.inf
     k, e = i, end
     for _ in range(n_near):
@@ -186,36 +213,37 @@ def _past_end(fences, near, n_near, i, end, sx, sy, sz, qx, qy, qz, own):
         if m < 0:
             if k == i:
                 return own
-            return min(best, _vertical_detour(sx, sy, sz, qx, qy, qz, fences[k, 2 * e], fences[k, 2 * e + 1],
-                                              fences[k, 4], fences[k, 5]))
+            return min(best, _vertical_detour(sx, sy, sz, ax, ay, az, bx, by, bz, seg, fences[k, 2 * e],
+                                              fences[k, 2 * e + 1], fences[k, 4], fences[k, 5]))
         j = near[m]
         # the steps in the wall's top and bottom where the two meet: at k's end, and at j's near end (the same
         # point where j starts there; inside k where k overlaps j)
         for x, y in ((fences[k, 2 * e], fences[k, 2 * e + 1]), (fences[j, 2 - 2 * far], fences[j, 3 - 2 * far])):
             for z in range(4, 6):
                 if fences[k, z] != fences[j, z]:
-                    best = min(best, _vertical_detour(sx, sy, sz, qx, qy, qz, x, y, min(fences[k, z], fences[j, z]),
-                                                      max(fences[k, z], fences[j, z])))
-        best = min(best, _level_detour(fences, j, 5, sx, sy, sz, qx, qy, qz),
-                   _bottom_detour(fences, j, sx, sy, sz, qx, qy, qz))
+                    best = min(best, _vertical_detour(sx, sy, sz, ax, ay, az, bx, by, bz, seg, x, y,
+                                                      min(fences[k, z], fences[j, z]), max(fences[k, z], fences[j, z])))
+        best = min(best, _level_detour(fences, j, 5, sx, sy, sz, ax, ay, az, bx, by, bz, seg),
+                   _bottom_detour(fences, j, sx, sy, sz, ax, ay, az, bx, by, bz, seg))
         k, e = j, far
     return min(best, own)  # not reached: each continuation lies further along the line
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _around_panel(fences, near, n_near, i, sx, sy, sz, qx, qy, qz, top, end0, end1):
-    """A lower bound on any path from s to q that passes panel i, when the straight path crosses it, given
-    the panel's edge detours ``top``, ``end0``, ``end1`` (``_panel_edges``).
+def _around_panel(fences, near, n_near, i, sx, sy, sz, ax, ay, az, bx, by, bz, seg, top, end0, end1):
+    """A lower bound on any path from s to the target (the point a, or any point of the segment ab with
+    ``seg``) that passes panel i, when every straight path from s to the target crosses it, given the panel's
+    edge terms ``top``, ``end0``, ``end1`` (``_panel_edges``, ``_edge_term``).
 
     The path must cross the wall's plane outside the wall (panel i and the near panels that continue it in
-    a straight line, ``continuation``), and |s - c| + |c - q| over the plane is convex with its minimum
-    inside panel i, so the shortest such crossing lies on the wall's border: the least of its edge detours.
-    A panel's bottom edge counts only if s or q lies at or below it: otherwise a path below the panel would
-    have to dip under the panel and come back up, and the segment from such a crossing to the straight
-    path's crossing enters the panel through an end edge or the top, at no greater length."""
-    lb = min(top, _bottom_detour(fences, i, sx, sy, sz, qx, qy, qz))
-    lb = min(lb, _past_end(fences, near, n_near, i, 0, sx, sy, sz, qx, qy, qz, end0))
-    return min(lb, _past_end(fences, near, n_near, i, 1, sx, sy, sz, qx, qy, qz, end1))
+    a straight line, ``continuation``), and for a target point q, |s - c| + |c - q| over the plane is convex
+    with its minimum inside panel i, so the shortest such crossing lies on the wall's border: the least of its
+    edge terms. A panel's bottom edge counts only if s or q lies at or below it: otherwise a path below the
+    panel would have to dip under the panel and come back up, and the segment from such a crossing to the
+    straight path's crossing enters the panel through an end edge or the top, at no greater length."""
+    lb = min(top, _bottom_detour(fences, i, sx, sy, sz, ax, ay, az, bx, by, bz, seg))
+    lb = min(lb, _past_end(fences, near, n_near, i, 0, sx, sy, sz, ax, ay, az, bx, by, bz, seg, end0))
+    return min(lb, _past_end(fences, near, n_near, i, 1, sx, sy, sz, ax, ay, az, bx, by, bz, seg, end1))
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -232,7 +260,8 @@ def _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
     for m in range(n_near):
         if _panel_across(fences, near[m], sx, sy, sz, qx, qy, qz):
             e = _panel_edges(fences, near[m], sx, sy, sz, qx, qy, qz)
-            a = _around_panel(fences, near, n_near, near[m], sx, sy, sz, qx, qy, qz, e[0], e[2], e[4])
+            a = _around_panel(fences, near, n_near, near[m], sx, sy, sz, qx, qy, qz, qx, qy, qz, False, e[0],
+                              e[2], e[4])
             around = a if a > around else around
             if first < 0:
                 first = m
@@ -291,3 +320,28 @@ def fence_detour(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
 def fence_detour_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff):
     """``fence_detour`` and its 1-Lipschitz lower bound (see ``_detour_and_bound``)."""
     return _detour_and_bound(fences, near, n_near, sx, sy, sz, qx, qy, qz, cutoff)
+
+
+@njit(cache=True, error_model="numpy", **NO_REFCOUNT)
+def shadow_bound(fences, near, n_near, sx, sy, sz, ax, ay, az, bx, by, bz):
+    """A lower bound on the length of every path from s to a point of the segment ab that passes no near
+    panel (a hand's way round the fences to a robot capsule's axis); 0 when no near panel lies across every
+    straight path from s to the segment.
+
+    A panel across s-a and s-b is across s-q for every q of ab: the straight paths from s meet the panel's
+    plane along a segment between the two crossings, which the convex panel holds. For each q the bound of
+    ``_around_panel`` holds, and each of its edge terms with the segment for target is no larger."""
+    lb = 0.0
+    for m in range(n_near):
+        i = near[m]
+        if not (_panel_across(fences, i, sx, sy, sz, ax, ay, az) and _panel_across(fences, i, sx, sy, sz, bx, by, bz)):
+            continue
+        top = _level_detour(fences, i, 5, sx, sy, sz, ax, ay, az, bx, by, bz, True)
+        # an end edge counts only where no panel continues the wall there (_past_end)
+        end0 = np.inf if continuation(fences, near, n_near, i, 0)[0] >= 0 else _vertical_detour(
+            sx, sy, sz, ax, ay, az, bx, by, bz, True, fences[i, 0], fences[i, 1], fences[i, 4], fences[i, 5])
+        end1 = np.inf if continuation(fences, near, n_near, i, 1)[0] >= 0 else _vertical_detour(
+            sx, sy, sz, ax, ay, az, bx, by, bz, True, fences[i, 2], fences[i, 3], fences[i, 4], fences[i, 5])
+        g = _around_panel(fences, near, n_near, i, sx, sy, sz, ax, ay, az, bx, by, bz, True, top, end0, end1)
+        lb = g if g > lb else lb
+    return lb

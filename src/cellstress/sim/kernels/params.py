@@ -128,6 +128,14 @@ class Work(NamedTuple):
     stack: np.ndarray  # (SWEEP_STACK, 6) its intervals still to test: s_a, s_b, d_a, d_b, depth, certified
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def near_size(n_fences):
+    """The length of a ``near`` array (``Work.near``) for a cell with ``n_fences`` panels: the near panels'
+    indices in its first ``n_fences`` slots, then for each panel and end the near panel that continues it there
+    (``kernels.fences.continuation``)."""
+    return 3 * n_fences + 1
+
+
 @njit(cache=True, error_model="numpy")
 def make_work(P):
     nj = P.placements.shape[0]
@@ -137,7 +145,7 @@ def make_work(P):
         np.zeros(nj), np.zeros(nj), np.zeros((nj, 3, 3)), np.zeros((nj, 3)),
         np.zeros((nc, 3)), np.zeros((nc, 3)),
         np.zeros((MAX_CAPSULES, 3)), np.zeros((MAX_CAPSULES, 3)), np.zeros(MAX_CAPSULES),
-        np.zeros((2, 3)), np.zeros((3, 3)), np.zeros(P.fences.shape[0] + 1, dtype=np.int64),
+        np.zeros((2, 3)), np.zeros((3, 3)), np.zeros(near_size(P.fences.shape[0]), dtype=np.int64),
         np.zeros(3),
         np.zeros(2 * nc), np.zeros(2 * nc), np.full(2, np.nan), P.fences.copy(),
         np.zeros(njx), np.zeros(njx), np.zeros((njx, 3, 3)), np.zeros((njx, 3)), np.zeros((ncx, 3)),

@@ -6,6 +6,7 @@ import numpy as np
 
 from cellstress.core.jit import njit
 from cellstress.sim.geometry import segment_segment_xyz
+from cellstress.sim.kernels.fences import shadow_bound
 from cellstress.sim.kernels.reach import fenced_reach, reach_field_at, reach_to_segment
 from cellstress.sim.layout import (
     M_D,
@@ -72,6 +73,11 @@ def separation(cap_r, reach, origin, grid_h, arm_len, fences, near, ra, rb, sh, 
         lbs[m] = np.inf
         c, side = m // 2, m % 2
         r = cap_r[c]
+        # a hand that must go round a panel to reach any point of this axis cannot come closer than that way
+        if n_near > 0 and best < np.inf and shadow_bound(
+                fences, near, np.int64(n_near), sh[side, 0], sh[side, 1], sh[side, 2], ra[c, 0], ra[c, 1], ra[c, 2],
+                rb[c, 0], rb[c, 1], rb[c, 2]) - arm_len - r - 1e-9 >= best:
+            continue
         t = ts[m]
         px, py, pz = ra[c, 0] + t * (rb[c, 0] - ra[c, 0]), ra[c, 1] + t * (rb[c, 1] - ra[c, 1]), \
             ra[c, 2] + t * (rb[c, 2] - ra[c, 2])
