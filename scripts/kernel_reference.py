@@ -5,7 +5,8 @@
     python scripts/kernel_reference.py compare OLD.npz NEW.npz
 
 For each reference cell (the paper's four unless ``--cells`` names others; ``all``: every built-in cell):
-every ``run_batch`` output for random actions (numpy Generator, seed 123), 200 whole traces (``Simulator.run``), 300 episodes played through ``Simulator.step``, s0 and its metric row.
+every ``run_batch`` output for random actions (numpy Generator, seed 123), 200 whole traces
+(``Simulator.run``), 300 episodes played through ``Simulator.step``, s0 and its metric row.
 Use it around a speed change that must not change results: record before, check after (exit 1 on any
 difference, which it lists). Around a change that may move d_HR within the trace's tolerance, record before
 and after and ``compare``: per cell, whether the unsafe episodes and steps are the same, how far d_HR moved
