@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -130,6 +131,9 @@ def test_a_line_cut_short_is_dropped(whole, tmp_path):
     (lambda lines: lines[:1] + [lines[1].replace(b'"task":0', b'"task":7')] + lines[2:], "not a sub-tree of this"),
     (lambda lines: lines[:1] + [lines[1].replace(b'"undecided":0', b'"undecided":3')] + lines[2:],
      "not decided whole"),
+    # a witness naming an action the cell's worker does not have (the paper worker has 30)
+    (lambda lines: lines[:1] + [re.sub(rb'"actions":\[\d+', b'"actions":[99', lines[1], count=1)] + lines[2:],
+     "an action this cell's worker does not have"),
 ])
 def test_a_foreign_or_damaged_checkpoint_is_refused(whole, tmp_path, capsys, change, words):
     cell, _ = whole
@@ -140,7 +144,7 @@ def test_a_foreign_or_damaged_checkpoint_is_refused(whole, tmp_path, capsys, cha
     with pytest.raises(KeyboardInterrupt):
         cellstress.verify(cell, horizon=HORIZON, phases=PHASES, out=out, progress=stop)
     lines = (out / CHECKPOINT).read_bytes().splitlines()
-    assert b'"task":0' in lines[1]
+    assert b'"task":0' in lines[1] and b'"actions":[' in lines[1]  # (the first sub-tree is hazardous)
     (out / CHECKPOINT).write_bytes(b"\n".join(change(lines)) + b"\n")
     code = main(["verify", str(cell), "--horizon", str(HORIZON), "--phases", PHASES, "--workers", "1", "--out",
                  str(out)])
