@@ -40,7 +40,7 @@ from cellstress.core.jit import njit, prange
 from cellstress.human.actions import A_DIR, A_FWD, A_LAT, A_SET_TRUNK, A_TURN, A_WALK
 from cellstress.sim import layout as L
 from cellstress.sim.kernels.body import REACH_SLACK, pose_body
-from cellstress.verifier.reach import SUB, window_start
+from cellstress.verifier.reach import SUB, point_axis_distance, window_start
 
 GRID3 = 0.1  # m: the 3-D grid of the window fields
 KEY_SPACING = 0.1  # m: the largest gap between key points along a leg or the trunk
@@ -143,14 +143,8 @@ def _node(robots, f, px, py, pz):
     for s in range(lo, hi + 1):
         for c in range(cap_r.shape[1]):
             ax, ay, az = ra[r, s, c, 0], ra[r, s, c, 1], ra[r, s, c, 2]
-            ux, uy, uz = rb[r, s, c, 0] - ax, rb[r, s, c, 1] - ay, rb[r, s, c, 2] - az
-            den = ux * ux + uy * uy + uz * uz
-            t = 0.0
-            if den > 0.0:
-                t = ((px - ax) * ux + (py - ay) * uy + (pz - az) * uz) / den
-                t = min(1.0, max(0.0, t))
-            dx, dy, dz = px - ax - t * ux, py - ay - t * uy, pz - az - t * uz
-            d = np.sqrt(dx * dx + dy * dy + dz * dz) - cap_r[r, c]
+            d = point_axis_distance(px, py, pz, ax, ay, az, rb[r, s, c, 0] - ax, rb[r, s, c, 1] - ay,
+                                    rb[r, s, c, 2] - az) - cap_r[r, c]
             if d < best:
                 best = d
     return best - allowance[r]

@@ -181,6 +181,18 @@ def _window_bound(samples, x0, y0, g, sub, dt, scal, steps_left, stride, states,
         out[c] = best
 
 
+@njit(cache=True, inline="always")
+def point_axis_distance(px, py, pz, ax, ay, az, ux, uy, uz):
+    """Distance from p to the capsule axis a + t u, t in [0, 1] (the capsule's surface is its radius closer)."""
+    den = ux * ux + uy * uy + uz * uz
+    t = 0.0
+    if den > 0.0:
+        t = ((px - ax) * ux + (py - ay) * uy + (pz - az) * uz) / den
+        t = min(1.0, max(0.0, t))
+    dx, dy, dz = px - ax - t * ux, py - ay - t * uy, pz - az - t * uz
+    return np.sqrt(dx * dx + dy * dy + dz * dz)
+
+
 @njit(cache=True, parallel=True)
 def _sample_field(ra, rb, cap_r, x0, y0, g, z, out):
     """out[s, i, j]: least distance from (x0 + i g, y0 + j g, z) to the capsules of robot sample s."""
@@ -192,14 +204,8 @@ def _sample_field(ra, rb, cap_r, x0, y0, g, z, out):
                 best = np.inf
                 for c in range(cap_r.shape[0]):
                     ax, ay, az = ra[s, c, 0], ra[s, c, 1], ra[s, c, 2]
-                    ux, uy, uz = rb[s, c, 0] - ax, rb[s, c, 1] - ay, rb[s, c, 2] - az
-                    den = ux * ux + uy * uy + uz * uz
-                    f = 0.0
-                    if den > 0.0:
-                        f = ((px - ax) * ux + (py - ay) * uy + (z - az) * uz) / den
-                        f = min(1.0, max(0.0, f))
-                    dx, dy, dz = px - ax - f * ux, py - ay - f * uy, z - az - f * uz
-                    d = np.sqrt(dx * dx + dy * dy + dz * dz) - cap_r[c]
+                    d = point_axis_distance(px, py, z, ax, ay, az, rb[s, c, 0] - ax, rb[s, c, 1] - ay,
+                                            rb[s, c, 2] - az) - cap_r[c]
                     if d < best:
                         best = d
                 out[s, i, j] = best

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cellstress.sim import layout as L
-from cellstress.sim.kernels.expand import expand_pairs, expand_states
+from cellstress.sim.kernels.expand import expand_pairs
 from cellstress.verifier.bounds import DISTANCE, Bounds
 
 CHILDREN = 8192 * 30  # children per compiled expansion (bounds memory; the time limit and progress are checked between)
@@ -168,10 +168,7 @@ def decide(sim, horizon: int, bounds: Bounds, *, deadline: float | None = None,
             children = np.empty((n_child, L.NS))
             last = np.empty((n_child, L.NM))
             d_min = np.empty(n_child)
-            if clear is None:
-                expand_states(sim.params, parents, n_act, children, last, d_min)
-            else:
-                expand_pairs(sim.params, parents, parent, action, children, last, d_min)
+            expand_pairs(sim.params, parents, parent, action, children, last, d_min)
             judge(parents, children, last, d_min, parent, action)
             out.expanded += n_child
             cmult = pmult[parent]

@@ -15,7 +15,7 @@ from cellstress.sim.kernels.params import make_work
 from cellstress.sim.kernels.step import step_action
 from cellstress.sim.layout import M_D, NM, NS
 
-EXPAND_CHUNK = 64  # children per work-array set in expand_states
+EXPAND_CHUNK = 64  # children per work-array set in expand_pairs
 
 
 @njit(cache=True, error_model="numpy", **NO_REFCOUNT)
@@ -35,30 +35,22 @@ def _expand_one(P, states, p, a, c, W, state, rows, children, last, d_min):
         last[c, i] = rows[n - 1, i] if n > 0 else np.nan
 
 
-@njit(cache=True, error_model="numpy", parallel=True)
 def expand_states(P, states, n_act, children, last, d_min):
     """children[i * n_act + a]: states[i] after action a (n_act actions, 0..n_act-1); last: the metric row of
     the child's last step, d_min: the least d_HR over the action's steps (NaN / inf for a parent that was
-    already unsafe, which does not move)."""
-    n_child = states.shape[0] * n_act
-    spa = P.spa
-    # One work-array set per chunk of children, as run_batch does: a step's results do not depend on what the
-    # arrays held before.
-    n_chunks = (n_child + EXPAND_CHUNK - 1) // EXPAND_CHUNK
-    for chunk in prange(n_chunks):
-        W = make_work(P)
-        state = np.empty(NS)
-        rows = np.empty((spa, NM))
-        for c in range(chunk * EXPAND_CHUNK, min(n_child, (chunk + 1) * EXPAND_CHUNK)):
-            _expand_one(P, states, c // n_act, c % n_act, c, W, state, rows, children, last, d_min)
+    already unsafe, which does not move). (``expand_pairs`` over every (parent, action) pair in that order.)"""
+    parent = np.repeat(np.arange(states.shape[0]), n_act)
+    action = np.tile(np.arange(n_act), states.shape[0])
+    expand_pairs(P, states, parent, action, children, last, d_min)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def expand_pairs(P, states, parent, action, children, last, d_min):
-    """children[i]: states[parent[i]] after action[i]; last and d_min as for ``expand_states`` (the children a
-    bound could not clear, in any order)."""
+    """children[i]: states[parent[i]] after action[i]; last and d_min as for ``expand_states``."""
     n_child = parent.shape[0]
     spa = P.spa
+    # One work-array set per chunk of children, as run_batch does: a step's results do not depend on what the
+    # arrays held before.
     n_chunks = (n_child + EXPAND_CHUNK - 1) // EXPAND_CHUNK
     for chunk in prange(n_chunks):
         W = make_work(P)
