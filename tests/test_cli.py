@@ -132,6 +132,37 @@ def test_check_exits_1_on_a_failed_static_check(capsys, cell) -> None:
     assert out.strip().splitlines()[-1].startswith("FAIL: the cell file is valid, the static check fails (")
 
 
+def test_check_witness_finds_each_rows_way_and_writes_replayable_results(capsys, tmp_path) -> None:
+    """``check --witness``: one line per failing row after the static check, FOUND with the actions; each
+    search's result file in search-N under --out, with the aim it was given; the exit code stays the check's."""
+    from cellstress.searchers.result import SearchResult
+
+    code, out, err = _run(["check", "s3-fence-gap", "--witness", "--out", str(tmp_path / "w")], capsys)
+    assert code == 1, err
+    lines = out.splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln.startswith("simulated witnesses (plan, 200 episodes"))
+    rows = lines[head + 1: head + 3]
+    assert rows[0].startswith("  front-scanner: FOUND at episode ") and "search-1" in rows[0]
+    assert rows[1].startswith("  undetected-reach: FOUND at episode ") and "search-2" in rows[1]
+    assert lines[-1].startswith("FAIL: the cell file is valid, the static check fails (")
+    res = SearchResult.load(tmp_path / "w" / "search-1")
+    assert res.searcher == "plan" and res.params["aim"].count(",") == 3
+    witness = rows[0].split(": ", 2)[2].split(" (")[0].split(", ")
+    assert list(res.hazards[[h.actions for h in res.hazards].index(tuple(witness))].actions) == witness
+
+
+@pytest.mark.parametrize("args", [["--budget", "5"], ["--seed", "3"], ["--out", "x"]])
+def test_check_witness_options_need_witness(capsys, args) -> None:
+    code, out, err = _run(["check", "s3-fence-gap", *args], capsys)
+    assert code == 2 and "--witness" in err and len(err.strip().splitlines()) == 1
+
+
+def test_check_witness_on_a_passing_cell_searches_nothing(capsys) -> None:
+    code, out, err = _run(["check", "baseline", "--witness"], capsys)
+    assert code == 0, err
+    assert "simulated witnesses" not in out
+
+
 def test_check_file_path(capsys, baseline, tmp_path) -> None:
     cell = copy.deepcopy(baseline)
     cell["name"] = "my-cell"

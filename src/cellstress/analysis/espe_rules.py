@@ -68,6 +68,7 @@ class CurtainReachOver:
     robot_part: str = ""
     t: float = math.nan  # s, episode time of that pose (mod the cycle)
     sim_note: str = CANNOT_REACH_OVER  # what the simulated worker cannot do here ("": the articulated worker can)
+    beam_line: tuple[tuple[float, float], tuple[float, float]] | None = None  # the curtain's line on the floor
 
     @property
     def required(self) -> float:
@@ -132,7 +133,8 @@ def curtain_reach_over(device: LightCurtain, vol: HazardVolume, T: float, throug
         i = int(np.flatnonzero(cut)[k])
         row = CurtainReachOver(device.name, float(device.top), T, I.K_REACH_OVER, c, (max(lo, 0.0), hi),
                                float(min(max(vol.c[i, 2], lo, 0.0), hi)), max(float(dist[k]), 0.0), through, robot,
-                               vol.part_names[int(vol.part[i])], round(float(vol.t[i]), 3), note)
+                               vol.part_names[int(vol.part[i])], round(float(vol.t[i]), 3), note,
+                               (tuple(map(float, device.start)), tuple(map(float, device.end))))
         if best is None or row.behind - row.required < best.behind - best.required - 1e-12:
             best = row
     if best is None:  # (no zone at all)

@@ -9,7 +9,10 @@ import typer
 from cellstress.cli.common import (
     CELL_HELP,
     JUNIT_HELP,
+    CellstressError,
     check_junit_path,
+    check_out_dir,
+    fail,
     first_sentence,
     num,
     say,
@@ -22,11 +25,19 @@ from cellstress.cli.common import (
 def check(
     cell: Annotated[str, typer.Argument(help=CELL_HELP)],
     junit: Annotated[str | None, typer.Option("--junit", help=JUNIT_HELP + " One test case per check row.")] = None,
+    witness: Annotated[bool, typer.Option("--witness", help="For each row the static check fails, search for a "
+                                          "simulated worker who takes that way in: plan, aimed at the robot point "
+                                          "and moment the row names. Each row: FOUND (the actions), not "
+                                          "reproduced, or what the simulated worker cannot do.")] = False,
+    budget: Annotated[int, typer.Option("--budget", "-b", help="With --witness: episodes per search.")] = 200,
+    seed: Annotated[int, typer.Option("--seed", help="With --witness: the searches' seed (>= 0).")] = 0,
+    out: Annotated[str | None, typer.Option("--out", "-o", help="With --witness: write each search's result.json "
+                                            "into a folder search-N here (replay, report).")] = None,
 ) -> None:
     """Validate a cell file, print a summary of it and run the static ISO 13855 / ISO 13857 check.
 
     Exit code 0 if the static check passes, 1 if it fails (a gate for a design in CI), 2 for a file that is not
-    a valid cell."""
+    a valid cell. --witness also searches the simulation for each failing row's way in (docs/cells.md)."""
     from cellstress.analysis.check_rows import check_rows
     from cellstress.analysis.iso13855 import check_cell
     from cellstress.analysis.program_check import check_programs
@@ -34,9 +45,15 @@ def check(
     from cellstress.cell.load import BUILTIN_CELLS, builtin_file, load_cell
     from cellstress.report.junit import check_suite
     from cellstress.robot.geometry import robot_geometry
+    from cellstress.searchers.common import check_common
     from cellstress.sim.build import build_layout
 
     junit_path = check_junit_path(junit)
+    with user_errors():
+        check_common(budget, seed, "first", 0)
+        if (out is not None or budget != 200 or seed != 0) and not witness:
+            raise CellstressError("--budget, --seed and --out go with --witness")
+    out_dir = check_out_dir(out) if out is not None else None
     with spinner_while_compiling(), user_errors():
         c = load_cell(cell)
         spec = c.spec
@@ -82,12 +99,38 @@ def check(
     for line in static.lines():
         out(f"  {line}")
     failures = [f for p in programs for f in p.failures()] + static.failures()
-    write_junit_file(junit_path, [check_suite(spec.name, check_rows(static, programs))])
+    rows = check_rows(static, programs)
+    if witness and failures:
+        _witness_lines(c, layout, rows, budget, seed, out_dir)
+    write_junit_file(junit_path, [check_suite(spec.name, rows)])
     if not failures:
         out("PASS: the cell file is valid and the static check passes")
     else:
         out(f"FAIL: the cell file is valid, the static check fails ({', '.join(failures)})")
         raise typer.Exit(1)
+
+
+def _witness_lines(c, layout, rows, budget: int, seed: int, out_dir) -> None:
+    """``--witness``: a simulated worker's way in for each failing row (analysis.witness), one line per row."""
+    from cellstress.analysis.witness import SEARCHER, witness_searches
+    from cellstress.sim.simulator import Simulator
+
+    with spinner_while_compiling(), user_errors():
+        found = witness_searches(Simulator(c), rows, budget, seed)
+    say(f"simulated witnesses ({SEARCHER}, {budget} episodes per search, seed {seed}; aimed at each row's robot "
+        "point and moment where it names one):")
+    folders: dict[int, str] = {}
+    for w in found:
+        where = ""
+        if out_dir is not None and w.result is not None:
+            key = id(w.result)
+            if key not in folders:
+                try:
+                    folders[key] = str(w.result.write(out_dir / f"search-{len(folders) + 1}", inside=out_dir))
+                except OSError as exc:
+                    raise fail(f"--out {out_dir}: cannot write result.json ({exc.strerror or exc})") from None
+            where = f" ({folders[key]})"
+        say(f"  {w.line()}{where}")
 
 
 def _file_lines(c) -> None:

@@ -33,7 +33,7 @@ def _searcher_help() -> str:
 
 def _params_text(params: dict) -> str:
     return ", ".join(f"{k} {'auto' if v is None else num(v) if isinstance(v, float) else v}"
-                     for k, v in params.items())
+                     for k, v in params.items() if v != "")  # (an empty text option is one not given: plan's aim)
 
 
 def search(

@@ -221,7 +221,7 @@ def hazard_page(res: SearchResult, view: EpisodeView, acc: Account, top: Path, c
                          "lateral [deg]", "min d_HR [m]", "max v_R [m/s]", "seen by", "robot at end"],
                         rows, numeric={0, 2, 3, 4, 5, 6, 7, 8}, row_classes=classes))
     body.append("<h2>Parameters</h2>")
-    params = ", ".join(f"{k} = {v}" for k, v in sorted(res.params.items()))
+    params = ", ".join(f"{k} = {v}" for k, v in sorted(res.params.items()) if v != "")  # (empty text: not given)
     spec = view.layout.cell.spec
     body.append(H.table(None, [
         ["cell", f"{cell} ({res.cell.source})"],

@@ -52,6 +52,15 @@ Defaults (``n_init`` = 2, ``init_sticky`` = 0.9, ``candidates`` = 200, ``explore
 ``pool`` = 5, ``keep_tail`` = 0.5) were chosen on the three flawed cells, seeds 0-39, budget 200;
 docs/results.md gives the numbers and the settings tried.
 
+**Aimed** (``aim``, used by ``cellstress check --witness``): a point the robot sweeps at a known moment, given
+beforehand, as the static check finds it (``"T,X,Y,Z"``: at episode time T [s] from the cell's own phase, modulo
+the robot's cycle, the robot's surface passes through (X, Y, Z) m; ``"T,X,Y,Z,R"`` for robot R of a cell of
+several). The model starts out knowing that point, at offset 0 and moving, at every step of the path that meets
+that moment (the nearest step); the rows played teach the rest as before, and replace its speed where they show
+the robot's real one there. The ``n_init`` start episodes are then each the best predicted of ``candidates``
+sticky random ones instead of the first drawn: a point to go for is known before anything is played. A searched
+arrival phase moves robot R's clock with robot 0's (``sim.build.with_phase``).
+
 Randomness: one numpy Generator from ``SeedSequence(seed, spawn_key=(9,))``.
 """
 
@@ -75,6 +84,16 @@ CHUNK = 1_000_000  # capsule-point pairs measured at once (memory of the articul
 
 
 @dataclass(frozen=True)
+class Aim:
+    """A point (x, y, z) [m] on robot ``robot``'s surface at episode time ``time`` [s] from the cell's own phase,
+    modulo the robot's cycle (``Plan.aim``)."""
+
+    robot: int
+    time: float
+    point: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
 class Plan:
     """Options of ``plan``: ``n_init`` start episodes with repeat probability ``init_sticky``; per episode,
     ``candidates`` unplayed sequences, a share ``explore`` of them sticky random (repeat probability
@@ -88,6 +107,7 @@ class Plan:
     sticky: float = 0.3
     pool: int = 5
     keep_tail: float = 0.5
+    aim: str = ""  # "T,X,Y,Z" or "T,X,Y,Z,R": a robot point known beforehand (module docstring); "": none
 
     name: ClassVar[str] = "plan"
     needs: ClassVar[tuple[type, ...]] = (WorkerModel,)
@@ -101,6 +121,30 @@ class Plan:
         whole("pool", self.pool, 1, 10_000)
         for k in ("init_sticky", "explore", "sticky", "keep_tail"):
             number(k, getattr(self, k), 0.0, 1.0)
+        self.aimed()
+
+    def aimed(self) -> Aim | None:
+        """``aim`` read (SearchError for a malformed one), or None."""
+        if not isinstance(self.aim, str):
+            raise SearchError(f"aim must be text such as '1.46,0.79,0.75,1.10', not {self.aim!r}")
+        if not self.aim.strip():
+            return None
+        parts = self.aim.split(",")
+        try:
+            values = [float(p) for p in parts]
+        except ValueError:
+            values = []
+        if len(parts) not in (4, 5) or not all(math.isfinite(v) for v in values) or len(values) != len(parts):
+            raise SearchError(f"aim must be T,X,Y,Z or T,X,Y,Z,ROBOT (numbers), not {self.aim[:80]!r}")
+        t, x, y, z = values[:4]
+        number("aim's time", t, 0.0, 1e6)
+        for name, v in (("x", x), ("y", y), ("z", z)):
+            number(f"aim's {name}", v, -1e4, 1e4)
+        robot = values[4] if len(values) == 5 else 0.0
+        if robot != int(robot):
+            raise SearchError(f"aim's robot must be a whole number, not {parts[4][:20]!r}")
+        whole("aim's robot", int(robot), 0, 1000)
+        return Aim(int(robot), t, (x, y, z))
 
     def run(self, problem, reward, rec: Recorder, seed: int) -> None:
         if not isinstance(problem, WorkerModel):
@@ -112,6 +156,9 @@ class Plan:
         lead = 1 if isinstance(problem, StartChoices) else 0
         n_first = problem.choices(0) if lead else 0
         model = _Model(problem, lead)
+        aim = self.aimed()
+        if aim is not None:
+            model.know(aim)
         # played sequence -> its least d_HR before any device reacted; a key shorter than the horizon is an
         # episode cut short by a hazard (with until="budget"), which any sequence beginning with it would replay
         closest: dict[tuple[int, ...], float] = {}
@@ -145,7 +192,17 @@ class Plan:
             closest[tuple(played)] = float(running.min()) if len(running) else math.inf
             rec.finish(played, ret, risk, unsafe)  # raises Stop at the end
 
+        def best(cands: set[tuple[int, ...]]) -> list[int]:
+            order = np.array(sorted(cands), dtype=np.int64)
+            score = model.predict(order)
+            ties = np.flatnonzero(score <= score.min())
+            return [int(a) for a in order[ties[int(rng.integers(len(ties)))]]]
+
         for _ in range(self.n_init):
+            if aim is not None:  # the model knows a point of the robot already: the start episodes go for it
+                starts = {tuple(sticky_tail([], self.init_sticky)) for _ in range(self.candidates)}
+                play(best({c for c in starts if not replays(c)} or {tuple(sticky_tail([], 0.0))}))
+                continue
             for _ in range(REDRAWS):  # very sticky episodes are often constant sequences: play each once
                 actions = sticky_tail([], self.init_sticky)
                 if not replays(tuple(actions)):
@@ -170,10 +227,7 @@ class Plan:
                         break
             if not cands:  # (every sequence near the played ones has been played: a tiny action space)
                 cands.add(tuple(sticky_tail([], 0.0)))
-            order = np.array(sorted(cands), dtype=np.int64)
-            score = model.predict(order)
-            ties = np.flatnonzero(score <= score.min())
-            play([int(a) for a in order[ties[int(rng.integers(len(ties)))]]])
+            play(best(cands))
 
 
 class _Model:
@@ -204,6 +258,26 @@ class _Model:
         self.feats: list[np.ndarray] = []
         self.seen: list[np.ndarray] = []
         self._tree = self._by_step = None
+
+    def know(self, aim: Aim) -> None:
+        """Take ``aim``'s point as on the moving robot at each path step of its moment (module docstring)."""
+        if aim.robot >= self.n_robots:
+            raise SearchError(f"aim names robot {aim.robot}; the cell has {self.n_robots}")
+        p = self.sim.params
+        scal = p.scal if aim.robot == 0 else p.x_scal[aim.robot - 1]
+        cycle, dt = float(scal[L.C_CYCLE]), float(p.scal[L.C_DT])
+        # path step i is episode time i dt from the cell's phase; with a searched phase (lead), i dt is robot 0's
+        # own path time, which the cell's phase is the origin of
+        origin = float(p.scal[L.C_PHASE0]) if self.lead else 0.0
+        i = np.arange(len(self.points[aim.robot]))
+        lag = np.mod(i * dt - origin - aim.time + 0.5 * cycle, cycle) - 0.5 * cycle
+        point = np.asarray(aim.point, dtype=float)
+        cell = tuple(np.round(point / POINT_GRID).astype(int))
+        for k in np.flatnonzero(np.abs(lag) <= 0.5 * dt + 1e-9):
+            self.points[aim.robot][k][cell] = (point, 0.0)
+            if np.isnan(self.speed[aim.robot][k]):
+                self.speed[aim.robot][k] = np.inf  # moving, until a row shows its speed there
+        self._by_step = None
 
     def distances(self, poses: np.ndarray, points: np.ndarray) -> np.ndarray:
         """The worker's side of d_HR from each of ``poses`` (n, N_POSE) to its ``points`` (n, m, 3; NaN: inf): the
@@ -302,11 +376,14 @@ class _Model:
         from scipy.spatial import cKDTree
 
         n, steps = len(seqs), self.n_steps
-        if self._tree is None:
-            self._tree = (cKDTree(np.concatenate(self.feats)), np.concatenate(self.seen))
-        tree, seen_at = self._tree
         poses = self.sim.worker_paths(seqs[:, self.lead:]).reshape(-1, L.N_POSE)
-        seen = seen_at[tree.query(self._features(poses))[1]].reshape(n, steps)
+        if not self.feats:  # nothing played yet (an aimed start): no device is known to see anything
+            seen = np.zeros((n, steps), dtype=np.int64)
+        else:
+            if self._tree is None:
+                self._tree = (cKDTree(np.concatenate(self.feats)), np.concatenate(self.seen))
+            tree, seen_at = self._tree
+            seen = seen_at[tree.query(self._features(poses))[1]].reshape(n, steps)
         known = np.zeros(n, dtype=np.int64)
         played_brake = np.full((self.n_robots, n), -1)
         played_stop = np.full((self.n_robots, n), -1)

@@ -1,0 +1,151 @@
+"""Simulated witnesses of the static check's failing rows (issue 34, part 5: ``check`` and the search agree).
+
+For every row the check fails, one of three answers:
+
+* the row's ``limit`` names what the simulated worker cannot do to take that way in: no search; the static
+  verdict stands on the standard's arithmetic alone;
+* a ``plan`` search aimed at the row's own geometric witness (``check_rows.RowPoint``: the robot capsule and the
+  moment of the cycle where the check found the zone too close, seen from where the worker stands or reaches
+  from): ``Plan.aim`` gives the model that point of the moving robot before the first episode. Rows with no such
+  point (openings, muting, a configured speed, beam heights) get the same search unaimed;
+* a robot program's own faults (``program`` rows) are no way in for a worker and are not searched.
+
+A hazard witnesses a row only if it takes the row's way in (``CheckRow.way``, ``takes_way``): a device too close
+to the zone is witnessed by a contact after that device saw the worker (its stop came too late); an undetected
+reach, a reach over a fence and a whole-body opening by a contact no stopping device saw coming; crawling under,
+stepping over, a low scanner plane and a short mat by a contact that device did not see; an automatic restart by
+a contact after the robot restarted by itself. The search runs to its first hazard; when that one takes another
+way in, it runs its whole budget and the first of its hazards that takes the row's way is the witness. Searches
+are shared between rows with the same aim.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from cellstress.analysis.check_rows import CheckRow, RowPoint
+from cellstress.analysis.hazard_zone import SAMPLE_DT, robot_poses
+from cellstress.analysis.plane import point_segment
+from cellstress.searchers import search
+from cellstress.searchers.plan import Aim
+from cellstress.searchers.result import EpisodeRef, SearchResult
+
+SEARCHER = "plan"
+AXIS_SAMPLES = 41  # points along the capsule's axis where the one nearest the worker's side is picked
+STOPPING = ("stop-pending", "braking", "stopped")  # StepRecord.stop_phase while a stop holds the robot
+
+
+@dataclass(frozen=True)
+class RowWitness:
+    """A failing check row and what the simulation made of it."""
+
+    row: str  # the check row's name
+    limit: str  # what the simulated worker cannot do ('' : searched, or not a way in)
+    aim: Aim | None  # the robot point and moment searched for (None: unaimed, or not searched)
+    result: SearchResult | None  # the search that decided it (None: not searched)
+    witness: EpisodeRef | None  # its first hazard that takes the row's way in (None: none in the budget)
+    hazards: int = 0  # hazardous episodes of that search in all (those not this way in included)
+
+    def line(self) -> str:
+        res, w = self.result, self.witness
+        if res is None:
+            return f"{self.row}: {self.limit}" if self.limit else \
+                f"{self.row}: a fault of the robot's program, no way in for a worker: not searched"
+        if w is None:
+            other = f" ({self.hazards} hazardous episodes, none of them this way in)" if self.hazards else ""
+            return f"{self.row}: not reproduced in {res.episodes} episodes{other}: the static verdict stands"
+        return f"{self.row}: FOUND at episode {w.episode} of {res.budget}: {', '.join(w.actions)}"
+
+
+def takes_way(row: CheckRow, layout, records, unsafe_row: int) -> bool:
+    """Whether a hazardous episode (its step records, unsafe at ``unsafe_row``) takes ``row``'s way in
+    (``CheckRow.way``)."""
+    before = records[: unsafe_row + 1]
+    seen = {name for r in before for name in r.devices}
+    if row.way == "late":
+        return row.device in seen
+    if row.way == "unseen":
+        if row.device:
+            return row.device not in seen
+        P = layout.params
+        stopping = {n for i, n in enumerate(layout.device_names) if P.dev_speed[i] == 0.0}
+        return not seen & stopping
+    if row.way == "restart":
+        phases = [r.stop_phase in STOPPING for r in before]
+        return any(a and not b for a, b in zip(phases, phases[1:], strict=False))
+    return row.way == "any"
+
+
+def aim_of(layout, point: RowPoint) -> Aim:
+    """The robot point of a row's witness: on the axis of its capsule at its moment, the point nearest (across
+    the floor) to the worker's side, moved out to the capsule's surface towards it."""
+    names = [p.name for p in layout.robots]
+    robot = names.index(point.robot) if point.robot and point.robot in names else 0
+    part = [c.name for c in layout.capsules].index(point.part)
+    ts, caps, ra, rb = robot_poses(layout.params, SAMPLE_DT, robot=robot)[0]
+    k = int(np.argmin(np.abs(ts - point.t)))
+    j = int(np.flatnonzero(caps == part)[0])
+    s = np.linspace(0.0, 1.0, AXIS_SAMPLES)[:, None]
+    axis = ra[k, j] + s * (rb[k, j] - ra[k, j])
+    (x0, y0), (x1, y1) = point.toward
+    d, qx, qy = point_segment(axis[:, 0], axis[:, 1], x0, y0, x1, y1)
+    i = int(np.argmin(d))
+    p = axis[i].copy()
+    step = np.array([qx[i] - p[0], qy[i] - p[1]])
+    gap = float(np.hypot(*step))
+    if gap > 1e-9:
+        p[:2] += step / gap * min(float(layout.params.cap_r[part]), gap)
+    return Aim(robot, float(ts[k]), (float(p[0]), float(p[1]), float(p[2])))
+
+
+def aim_text(aim: Aim | None) -> str:
+    """``Plan.aim``'s text for ``aim`` ('' for none)."""
+    if aim is None:
+        return ""
+    t, (x, y, z) = aim.time, aim.point
+    return f"{t:.4f},{x:.4f},{y:.4f},{z:.4f}" + (f",{aim.robot}" if aim.robot else "")
+
+
+def witness_searches(sim, rows: tuple[CheckRow, ...], budget: int, seed: int, progress=None, aimed: bool = True
+                     ) -> tuple[RowWitness, ...]:
+    """Search a simulated witness for every failing row of ``rows`` (``check_rows``) on the cell simulator
+    ``sim`` (module docstring): ``plan``, ``budget`` episodes from ``seed``; to the first hazard, and when that
+    one does not take the row's way in, the whole budget, whose hazards are then tried in order.
+    ``progress(row name)`` before each row's searches; ``aimed=False`` searches every row unaimed (to measure
+    what the aim brings: benchmarks/check_witness.py)."""
+    runs: dict[tuple[str, str], SearchResult] = {}
+    plays: dict[tuple[str, ...], tuple] = {}
+
+    def run(aim: str, until: str) -> SearchResult:
+        if (aim, until) not in runs:
+            runs[aim, until] = search(sim, SEARCHER, budget, seed, until=until, aim=aim)
+        return runs[aim, until]
+
+    def takes(row: CheckRow, actions: tuple[str, ...]) -> bool:
+        if actions not in plays:
+            trace = sim.run(list(actions))
+            plays[actions] = (trace.records(), trace.unsafe_row)
+        records, at = plays[actions]
+        return at is not None and takes_way(row, sim.layout, records, at)
+
+    out = []
+    for r in (r for r in rows if not r.ok):
+        if r.limit or not r.way:
+            out.append(RowWitness(r.name, r.limit, None, None, None))
+            continue
+        if progress is not None:
+            progress(r.name)
+        aim = aim_of(sim.layout, r.point) if aimed and r.point is not None and math.isfinite(r.point.t) else None
+        text = aim_text(aim)
+        res = run(text, "first")
+        if res.hazard is None or takes(r, tuple(res.hazard.actions)):
+            out.append(RowWitness(r.name, "", aim, res, None if res.hazard is None else
+                                  EpisodeRef(episode=res.hazard.episode, actions=res.hazard.actions), len(res.hazards)))
+            continue
+        res = run(text, "budget")
+        hit = next((h for h in res.hazards if takes(r, tuple(h.actions))), None)
+        out.append(RowWitness(r.name, "", aim, res, hit, len(res.hazards)))
+    return tuple(out)

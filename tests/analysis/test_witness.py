@@ -1,0 +1,102 @@
+"""``check --witness`` (analysis.witness): each failing row of the static check gets a simulated witness that
+takes the row's own way in, the reason it cannot, or an honest "not reproduced"; the aim is the check's own
+robot point, on the robot's surface at the row's moment."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cellstress.analysis.check_rows import CheckRow, check_rows
+from cellstress.analysis.hazard_zone import SAMPLE_DT, robot_poses
+from cellstress.analysis.iso13855 import check_cell
+from cellstress.analysis.program_check import check_programs
+from cellstress.analysis.witness import aim_of, aim_text, takes_way, witness_searches
+from cellstress.searchers.plan import Plan
+from cellstress.sim.simulator import Simulator
+
+
+@pytest.fixture(scope="module")
+def s3():
+    sim = Simulator("s3-fence-gap")
+    return sim, check_rows(check_cell(sim.cell, sim.layout), check_programs(sim.layout))
+
+
+def _row(rows, name: str) -> CheckRow:
+    return next(r for r in rows if r.name == name)
+
+
+def test_failing_rows_name_their_robot_point_and_way(s3) -> None:
+    _, rows = s3
+    scanner, reach = _row(rows, "front-scanner"), _row(rows, "undetected-reach")
+    assert not scanner.ok and not reach.ok
+    assert (scanner.way, scanner.device) == ("late", "front-scanner")
+    assert (reach.way, reach.device) == ("unseen", "")
+    assert scanner.point.part == "wrist_2_link" and scanner.point.t == pytest.approx(1.46)
+    # the scanner row measures from the field's open edge x = 1.5
+    assert scanner.point.toward[0][0] == pytest.approx(1.5)
+    # every row the check makes has a way, but a program's own
+    assert all(bool(r.way) != r.name.startswith("program") for r in rows)
+
+
+def test_aim_is_on_the_capsule_surface_towards_the_worker(s3) -> None:
+    sim, rows = s3
+    row = _row(rows, "front-scanner")
+    aim = aim_of(sim.layout, row.point)
+    ts, caps, ra, rb = robot_poses(sim.params, SAMPLE_DT, robot=0)[0]
+    k = int(np.argmin(np.abs(ts - row.point.t)))
+    part = [c.name for c in sim.layout.capsules].index(row.point.part)
+    j = int(np.flatnonzero(caps == part)[0])
+    a, b, p = ra[k, j], rb[k, j], np.asarray(aim.point)
+    s = np.clip(np.dot(p - a, b - a) / max(float(np.dot(b - a, b - a)), 1e-18), 0.0, 1.0)  # (a ball: a = b)
+    assert np.linalg.norm(p - (a + s * (b - a))) == pytest.approx(float(sim.params.cap_r[part]), abs=1e-9)
+    # pushed out towards the worker's side (the scanner's edge at x = 1.5 lies in +x of the robot)
+    assert p[0] > (a + s * (b - a))[0]
+    assert aim.time == pytest.approx(row.point.t) and aim.robot == 0
+    assert Plan(aim=aim_text(aim)).aimed() is not None  # the text plan reads
+
+
+def test_s3_witnesses_take_each_rows_way(s3) -> None:
+    """The scanner row's witness is seen by the scanner before the contact; the undetected reach's by no device;
+    each replays unsafe. The first hazard the search meets is the unseen one, so the scanner row needs the
+    budget run: its witness comes later in it."""
+    sim, rows = s3
+    got = {w.row: w for w in witness_searches(sim, rows, 200, 0)}
+    assert set(got) == {"front-scanner", "undetected-reach"}
+    for name, w in got.items():
+        assert w.witness is not None, w.line()
+        trace = sim.run(list(w.witness.actions))
+        assert trace.unsafe
+        records = trace.records()
+        seen = {d for r in records[: trace.unsafe_row + 1] for d in r.devices}
+        assert ("front-scanner" in seen) == (name == "front-scanner")
+        assert takes_way(_row(rows, name), sim.layout, records, trace.unsafe_row)
+        assert "FOUND at episode" in w.line() and w.aim is not None
+    first = got["undetected-reach"].witness
+    other = sim.run(list(first.actions))
+    assert not takes_way(_row(rows, "front-scanner"), sim.layout, other.records(), other.unsafe_row)
+    # the same again: a pure function of the seed
+    again = {w.row: w for w in witness_searches(sim, rows, 200, 0)}
+    assert {k: v.witness for k, v in again.items()} == {k: v.witness for k, v in got.items()}
+
+
+def test_rows_with_a_limit_or_no_way_are_not_searched(s3) -> None:
+    sim, _ = s3
+    rows = (CheckRow("reach-over", "x", False, "", "", "cannot reach over a 1.6 m top", way="unseen"),
+            CheckRow("program", "robot program", False, "", ""),
+            CheckRow("fine", "x", True, "", "", way="any"))
+    got = witness_searches(sim, rows, 5, 0)
+    assert [w.row for w in got] == ["reach-over", "program"]
+    assert all(w.result is None for w in got)
+    assert got[0].line() == "reach-over: cannot reach over a 1.6 m top"
+    assert "not searched" in got[1].line()
+
+
+def test_not_reproduced_says_so(s3) -> None:
+    """A row whose way no episode of a tiny budget takes: the line says the static verdict stands."""
+    sim, rows = s3
+    row = _row(rows, "front-scanner")
+    got = witness_searches(sim, (row,), 1, 0)
+    assert got[0].witness is None or got[0].witness.episode == 1
+    if got[0].witness is None:
+        assert "not reproduced in 1 episodes" in got[0].line() and "static verdict stands" in got[0].line()
