@@ -137,8 +137,13 @@ def test_check_witness_finds_each_rows_way_and_writes_replayable_results(capsys,
     search's result file in search-N under --out, with the aim it was given; the exit code stays the check's."""
     from cellstress.searchers.result import SearchResult
 
-    code, out, err = _run(["check", "s3-fence-gap", "--witness", "--out", str(tmp_path / "w")], capsys)
+    junit = tmp_path / "check.xml"
+    code, out, err = _run(["check", "s3-fence-gap", "--witness", "--out", str(tmp_path / "w"), "--junit",
+                           str(junit)], capsys)
     assert code == 1, err
+    xml = junit.read_text(encoding="utf-8")
+    assert xml.count("simulated: front-scanner: FOUND at episode") == 1
+    assert xml.count("simulated: undetected-reach: FOUND at episode") == 1
     lines = out.splitlines()
     head = next(i for i, ln in enumerate(lines) if ln.startswith("simulated witnesses (plan, 200 episodes"))
     rows = lines[head + 1: head + 3]

@@ -100,9 +100,8 @@ def check(
         out(f"  {line}")
     failures = [f for p in programs for f in p.failures()] + static.failures()
     rows = check_rows(static, programs)
-    if witness and failures:
-        _witness_lines(c, layout, rows, budget, seed, out_dir)
-    write_junit_file(junit_path, [check_suite(spec.name, rows)])
+    said = _witness_lines(c, rows, budget, seed, out_dir) if witness and failures else {}
+    write_junit_file(junit_path, [check_suite(spec.name, rows, said)])
     if not failures:
         out("PASS: the cell file is valid and the static check passes")
     else:
@@ -110,8 +109,9 @@ def check(
         raise typer.Exit(1)
 
 
-def _witness_lines(c, layout, rows, budget: int, seed: int, out_dir) -> None:
-    """``--witness``: a simulated worker's way in for each failing row (analysis.witness), one line per row."""
+def _witness_lines(c, rows, budget: int, seed: int, out_dir) -> dict[str, str]:
+    """``--witness``: a simulated worker's way in for each failing row (analysis.witness), one line per row;
+    returns each row's line (for the JUnit file)."""
     from cellstress.analysis.witness import SEARCHER, witness_searches
     from cellstress.sim.simulator import Simulator
 
@@ -120,6 +120,7 @@ def _witness_lines(c, layout, rows, budget: int, seed: int, out_dir) -> None:
     say(f"simulated witnesses ({SEARCHER}, {budget} episodes per search, seed {seed}; aimed at each row's robot "
         "point and moment where it names one):")
     folders: dict[int, str] = {}
+    said = {}
     for w in found:
         where = ""
         if out_dir is not None and w.result is not None:
@@ -130,7 +131,9 @@ def _witness_lines(c, layout, rows, budget: int, seed: int, out_dir) -> None:
                 except OSError as exc:
                     raise fail(f"--out {out_dir}: cannot write result.json ({exc.strerror or exc})") from None
             where = f" ({folders[key]})"
-        say(f"  {w.line()}{where}")
+        said[w.row] = w.line() + where
+        say(f"  {said[w.row]}")
+    return said
 
 
 def _file_lines(c) -> None:

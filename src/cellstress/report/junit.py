@@ -90,11 +90,15 @@ def write_junit(path: str | Path, suites: tuple[Suite, ...] | list[Suite]) -> Pa
 
 
 # ---- what each command reports -----------------------------------------------------------------------------
-def check_suite(cell: str, rows) -> Suite:
-    """``check``: one case per row (``analysis.check_rows``), a failed row a failure."""
+def check_suite(cell: str, rows, witnesses: dict[str, str] | None = None) -> Suite:
+    """``check``: one case per row (``analysis.check_rows``), a failed row a failure; ``witnesses`` (``check
+    --witness``): a row's simulated witness line, added to its text."""
+    said = witnesses or {}
     return Suite(f"cellstress check {cell}",
                  tuple(Case(r.name, f"check.{r.kind}", PASSED if r.ok else FAILED,
-                            "" if r.ok else f"{r.name}: {r.value}", r.detail, "" if not r.ok else r.value)
+                            "" if r.ok else f"{r.name}: {r.value}",
+                            r.detail + (f"\nsimulated: {said[r.name]}" if r.name in said else ""),
+                            "" if not r.ok else r.value)
                        for r in rows))
 
 
