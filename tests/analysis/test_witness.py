@@ -6,12 +6,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import yaml
 
 from cellstress.analysis.check_rows import CheckRow, check_rows
 from cellstress.analysis.hazard_zone import SAMPLE_DT, robot_poses
 from cellstress.analysis.iso13855 import check_cell
 from cellstress.analysis.program_check import check_programs
-from cellstress.analysis.witness import aim_of, aim_text, takes_way, witness_searches
+from cellstress.analysis.witness import aim_of, aim_text, out_of_reach, takes_way, witness_searches
+from cellstress.cell.load import builtin_text, parse_cell
 from cellstress.searchers.plan import Plan
 from cellstress.sim.simulator import Simulator
 
@@ -100,3 +102,18 @@ def test_not_reproduced_says_so(s3) -> None:
     assert got[0].witness is None or got[0].witness.episode == 1
     if got[0].witness is None:
         assert "not reproduced in 1 episodes" in got[0].line() and "static verdict stands" in got[0].line()
+
+
+def test_a_start_out_of_reach_is_named_not_searched(s3) -> None:
+    """s3-fence-gap on a floor 40 m long, the worker starting 20 m away: 8 actions of 0.2 s at 1.6 m/s get 2.56 m
+    plus a body's reach; every failing row says so, no search runs. At the cell's own start: nothing to say."""
+    sim, rows = s3
+    assert out_of_reach(sim) == ""
+    d = yaml.safe_load(builtin_text("s3-fence-gap"))
+    d["floor"]["ymax"] = 25.0
+    d["human"]["start"]["xy"] = [0.0, 20.0]
+    far = Simulator(parse_cell(yaml.safe_dump(d), "far", None))
+    why = out_of_reach(far)
+    assert why.startswith("the simulated worker cannot get there in one episode: the start is 1")
+    got = witness_searches(far, rows, 200, 0)
+    assert got and all(w.result is None and w.limit == why for w in got)

@@ -8,7 +8,9 @@ For every row the check fails, one of three answers:
   moment of the cycle where the check found the zone too close, seen from where the worker stands or reaches
   from): ``Plan.aim`` gives the model that point of the moving robot before the first episode. Rows with no such
   point (openings, muting, a configured speed, beam heights) get the same search unaimed;
-* a robot program's own faults (``program`` rows) are no way in for a worker and are not searched.
+* a robot program's own faults (``program`` rows) are no way in for a worker and are not searched; where no
+  episode can reach the robot at all from the start points (``out_of_reach``), no row is searched and each says
+  so.
 
 A hazard witnesses a row only if it takes the row's way in (``CheckRow.way``, ``takes_way``): a device too close
 to the zone is witnessed by a contact after that device saw the worker (its stop came too late); an undetected
@@ -27,11 +29,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from cellstress.analysis.check_rows import CheckRow, RowPoint
-from cellstress.analysis.hazard_zone import SAMPLE_DT, robot_poses
+from cellstress.analysis.hazard_zone import SAMPLE_DT, hazard_zone, robot_poses
 from cellstress.analysis.plane import point_segment
 from cellstress.searchers import search
 from cellstress.searchers.plan import Aim
 from cellstress.searchers.result import EpisodeRef, SearchResult
+from cellstress.sim import layout as L
 
 SEARCHER = "plan"
 AXIS_SAMPLES = 41  # points along the capsule's axis where the one nearest the worker's side is picked
@@ -109,6 +112,29 @@ def aim_text(aim: Aim | None) -> str:
     return f"{t:.4f},{x:.4f},{y:.4f},{z:.4f}" + (f",{aim.robot}" if aim.robot else "")
 
 
+def out_of_reach(sim) -> str:
+    """Why no episode can touch the robot at all ('' when one might): every start point is further from all the
+    robot sweeps (its swept floor footprint, ``hazard_zone``) than the worker can walk in one episode plus what a
+    body touches from where it stands. That reach is taken as stature + arm length from the hip, more than any
+    posture of either worker model gets (lying flat, arms stretched beyond the head), so the claim is safe."""
+    spec = sim.cell.spec
+    h = spec.human
+    starts = [s.xy for s in h.starts] or [h.start.xy]
+    zone = hazard_zone(sim.layout)
+    gap = min(float(np.min(point_segment(x, y, zone.a[:, 0], zone.a[:, 1], zone.b[:, 0], zone.b[:, 1])[0] - zone.r))
+              for x, y in starts)
+    ep = spec.simulation
+    t = ep.dt * ep.steps_per_action * ep.actions_per_episode
+    arm = float(sim.params.body[L.B_ARM_LEN])
+    reach = h.anthropometry.height + arm
+    if gap <= h.walking_speed * t + reach + 1e-9:
+        return ""
+    where = "every start point is" if len(starts) > 1 else "the start is"
+    return (f"the simulated worker cannot get there in one episode: {where} {gap:.2f} m from all the robot sweeps; "
+            f"in {t:g} s at {h.walking_speed:g} m/s, with a reach of {reach:.2f} m (stature + arm), a body touches "
+            f"nothing beyond {h.walking_speed * t + reach:.2f} m (a longer episode: simulation.actions_per_episode)")
+
+
 def witness_searches(sim, rows: tuple[CheckRow, ...], budget: int, seed: int, progress=None, aimed: bool = True
                      ) -> tuple[RowWitness, ...]:
     """Search a simulated witness for every failing row of ``rows`` (``check_rows``) on the cell simulator
@@ -132,9 +158,10 @@ def witness_searches(sim, rows: tuple[CheckRow, ...], budget: int, seed: int, pr
         return at is not None and takes_way(row, sim.layout, records, at)
 
     out = []
+    far = out_of_reach(sim) if any(not r.ok and r.way and not r.limit for r in rows) else ""
     for r in (r for r in rows if not r.ok):
-        if r.limit or not r.way:
-            out.append(RowWitness(r.name, r.limit, None, None, None))
+        if r.limit or not r.way or far:
+            out.append(RowWitness(r.name, r.limit or (far if r.way else ""), None, None, None))
             continue
         if progress is not None:
             progress(r.name)
