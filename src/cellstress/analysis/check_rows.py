@@ -11,9 +11,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Literal
 
 from cellstress.analysis.espe_rules import BeamHeights, CurtainReachOver, ScannerMounting
 from cellstress.verifier.records import StaticFailure
+
+Way = Literal["late", "unseen", "restart", "any", ""]  # CheckRow.way
 
 
 @dataclass(frozen=True)
@@ -44,7 +47,7 @@ class CheckRow:
     # what a simulated contact must show to take this row's way in (``analysis.witness``): "late" (``device`` saw
     # the worker before it), "unseen" (``device``, or with none every stopping device, did not), "restart" (the
     # robot restarted by itself before it), "any" (a hazard in the cell is all the row asks), "" (no way in)
-    way: str = ""
+    way: Way = ""
     device: str = ""
 
 

@@ -73,8 +73,12 @@ def takes_way(row: CheckRow, layout, records, unsafe_row: int) -> bool:
     if row.way == "unseen":
         if row.device:
             return row.device not in seen
+        # the devices that stop the row's robot (any robot, for a row that names none)
         P = layout.params
-        stopping = {n for i, n in enumerate(layout.device_names) if P.dev_speed[i] == 0.0}
+        names = [p.name for p in layout.robots]
+        r = names.index(row.point.robot) if row.point is not None and row.point.robot in names else -1
+        stopping = {n for i, n in enumerate(layout.device_names)
+                    if P.dev_speed[i] == 0.0 and (r < 0 or int(P.dev_robots[i]) >> r & 1)}
         return not seen & stopping
     if row.way == "restart":
         phases = [r.stop_phase in STOPPING for r in before]
