@@ -112,11 +112,19 @@ def check(
 def _witness_lines(c, rows, budget: int, seed: int, out_dir) -> dict[str, str]:
     """``--witness``: a simulated worker's way in for each failing row (analysis.witness), one line per row;
     returns each row's line (for the JUnit file)."""
+    from rich.console import Console
+    from rich.markup import escape
+
     from cellstress.analysis.witness import SEARCHER, witness_searches
+    from cellstress.core.text import for_terminal
     from cellstress.sim.simulator import Simulator
 
-    with spinner_while_compiling(), user_errors():
-        found = witness_searches(Simulator(c), rows, budget, seed)
+    console = Console(stderr=True)
+    with spinner_while_compiling(), user_errors(), console.status("", spinner="dots") as status:
+        def progress(row: str) -> None:  # (a terminal only: rich shows nothing elsewhere)
+            status.update(f"searching for a simulated witness of {escape(for_terminal(row))}")
+
+        found = witness_searches(Simulator(c), rows, budget, seed, progress if console.is_terminal else None)
     say(f"simulated witnesses ({SEARCHER}, {budget} episodes per search, seed {seed}; aimed at each row's robot "
         "point and moment where it names one):")
     folders: dict[int, str] = {}
