@@ -162,6 +162,16 @@ def test_check_witness_options_need_witness(capsys, args) -> None:
     assert code == 2 and "--witness" in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.parametrize("args, said", [(["--budget", "0"], "budget"), (["--seed", "-1"], "seed"),
+                                        (["--out", "FILE"], "--out")])
+def test_check_witness_bad_options_are_one_line(capsys, tmp_path, args, said) -> None:
+    (tmp_path / "FILE").write_text("x", encoding="utf-8")
+    args = [str(tmp_path / a) if a == "FILE" else a for a in args]
+    code, out, err = _run(["check", "s3-fence-gap", "--witness", *args], capsys)
+    assert code == 2 and said in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert "simulated witnesses" not in out
+
+
 def test_check_witness_on_a_passing_cell_searches_nothing(capsys) -> None:
     code, out, err = _run(["check", "baseline", "--witness"], capsys)
     assert code == 0, err
