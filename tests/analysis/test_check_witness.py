@@ -117,3 +117,20 @@ def test_a_start_out_of_reach_is_named_not_searched(s3) -> None:
     assert why.startswith("the simulated worker cannot get there in one episode: the start is 1")
     got = witness_searches(far, rows, 200, 0)
     assert got and all(w.result is None and w.limit == why for w in got)
+
+
+def test_a_row_about_one_robot_of_several_asks_for_a_contact_with_it() -> None:
+    """two-robots: nothing stops robot b, so the undetected reach to b fails; its witness touches b. The same
+    episode with its contact moved to robot a's capsule does not witness the row."""
+    sim = Simulator("two-robots")
+    rows = check_rows(check_cell(sim.cell, sim.layout), check_programs(sim.layout))
+    row = _row(rows, "undetected-reach:b")
+    (w,) = [w for w in witness_searches(sim, rows, 200, 0) if w.row == row.name]
+    assert w.witness is not None, w.line()
+    trace = sim.run(list(w.witness.actions))
+    records, at = list(trace.records()), trace.unsafe_row
+    assert records[at].robot_link.startswith("b:")
+    assert takes_way(row, sim.layout, records, at)
+    a_link = next(c.name for c in sim.layout.robots[0].capsules)
+    records[at] = records[at].model_copy(update={"robot_link": a_link})
+    assert not takes_way(row, sim.layout, records, at)

@@ -65,9 +65,14 @@ class RowWitness:
 
 def takes_way(row: CheckRow, layout, records, unsafe_row: int) -> bool:
     """Whether a hazardous episode (its step records, unsafe at ``unsafe_row``) takes ``row``'s way in
-    (``CheckRow.way``)."""
+    (``CheckRow.way``); in a cell of several robots, a row about one of them asks for a contact with it."""
     before = records[: unsafe_row + 1]
     seen = {name for r in before for name in r.devices}
+    names = [p.name for p in layout.robots]
+    robot = names.index(row.point.robot) if row.point is not None and row.point.robot in names else -1
+    if robot >= 0 and len(names) > 1 and records[unsafe_row].robot_link not in \
+            {c.name for c in layout.robots[robot].capsules}:
+        return False  # a row about one robot of several: the contact must be with that one
     if row.way == "late":
         return row.device in seen
     if row.way == "unseen":
@@ -75,10 +80,8 @@ def takes_way(row: CheckRow, layout, records, unsafe_row: int) -> bool:
             return row.device not in seen
         # the devices that stop the row's robot (any robot, for a row that names none)
         P = layout.params
-        names = [p.name for p in layout.robots]
-        r = names.index(row.point.robot) if row.point is not None and row.point.robot in names else -1
         stopping = {n for i, n in enumerate(layout.device_names)
-                    if P.dev_speed[i] == 0.0 and (r < 0 or int(P.dev_robots[i]) >> r & 1)}
+                    if P.dev_speed[i] == 0.0 and (robot < 0 or int(P.dev_robots[i]) >> robot & 1)}
         return not seen & stopping
     if row.way == "restart":
         phases = [r.stop_phase in STOPPING for r in before]
