@@ -15,6 +15,7 @@ from cellstress.analysis.program_check import check_programs
 from cellstress.analysis.witness import aim_of, aim_text, out_of_reach, takes_way, witness_searches
 from cellstress.cell.load import builtin_text, parse_cell
 from cellstress.searchers.plan import Plan
+from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
 
 
@@ -42,20 +43,41 @@ def test_failing_rows_name_their_robot_point_and_way(s3) -> None:
 
 
 def test_aim_is_on_the_capsule_surface_towards_the_worker(s3) -> None:
+    """s3's scanner row names the wrist at 1.46 s, the end of a move: the robot creeps to a stop there (slower than
+    the criterion's 1 mm/s), and a contact with a robot at rest is none, so the aim is the nearest point at a
+    moment (of 10 ms samples) when the capsule still moves faster than that: 1.43 s."""
     sim, rows = s3
     row = _row(rows, "front-scanner")
-    aim = aim_of(sim.layout, row.point)
+    aim = aim_of(sim, row.point)
     ts, caps, ra, rb = robot_poses(sim.params, SAMPLE_DT, robot=0)[0]
-    k = int(np.argmin(np.abs(ts - row.point.t)))
-    part = [c.name for c in sim.layout.capsules].index(row.point.part)
-    j = int(np.flatnonzero(caps == part)[0])
-    a, b, p = ra[k, j], rb[k, j], np.asarray(aim.point)
-    s = np.clip(np.dot(p - a, b - a) / max(float(np.dot(b - a, b - a)), 1e-18), 0.0, 1.0)  # (a ball: a = b)
-    assert np.linalg.norm(p - (a + s * (b - a))) == pytest.approx(float(sim.params.cap_r[part]), abs=1e-9)
+    k = int(np.argmin(np.abs(ts - aim.time)))
+    assert aim.time == pytest.approx(1.43) and aim.robot == 0
+    p = np.asarray(aim.point)
+    gaps = []
+    for j in range(len(caps)):
+        a, b = ra[k, j], rb[k, j]
+        s = np.clip(np.dot(p - a, b - a) / max(float(np.dot(b - a, b - a)), 1e-18), 0.0, 1.0)  # (a ball: a = b)
+        gaps.append(np.linalg.norm(p - (a + s * (b - a))) - float(sim.params.cap_r[caps[j]]))
+    j = int(np.argmin(np.abs(gaps)))
+    assert abs(gaps[j]) < 1e-9  # on a capsule's surface
+    assert [c.name for c in sim.layout.capsules][caps[j]] == "wrist_2_link"
+    v_tol = float(sim.params.scal[L.C_VTOL])
+    assert np.linalg.norm(ra[k + 1, j] - ra[k, j]) / SAMPLE_DT > v_tol  # moving then
+    assert np.linalg.norm(ra[k + 4, j] - ra[k + 3, j]) / SAMPLE_DT < v_tol  # at rest at the row's own moment
     # pushed out towards the worker's side (the scanner's edge at x = 1.5 lies in +x of the robot)
-    assert p[0] > (a + s * (b - a))[0]
-    assert aim.time == pytest.approx(row.point.t) and aim.robot == 0
+    assert p[0] > ra[k, j][0]
     assert Plan(aim=aim_text(aim)).aimed() is not None  # the text plan reads
+
+
+def test_aim_moves_to_a_moment_an_episode_meets(s3) -> None:
+    """s2-elbow-intrusion's curtain row names 1.72 s of the cycle; its episodes (fixed arrival) last 1.6 s, so the
+    aim is the nearest point at a moment within them."""
+    sim = Simulator("s2-elbow-intrusion")
+    rows = check_rows(check_cell(sim.cell, sim.layout), check_programs(sim.layout))
+    row = _row(rows, "bay-curtain")
+    assert row.point.t > 1.6
+    aim = aim_of(sim, row.point)
+    assert 0.0 <= aim.time <= 1.6 + 1e-9
 
 
 def test_s3_witnesses_take_each_rows_way(s3) -> None:

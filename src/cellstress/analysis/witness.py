@@ -35,6 +35,7 @@ from cellstress.searchers import search
 from cellstress.searchers.plan import Aim
 from cellstress.searchers.result import EpisodeRef, SearchResult
 from cellstress.sim import layout as L
+from cellstress.sim.starts import arrival_phases
 
 SEARCHER = "plan"
 AXIS_SAMPLES = 41  # points along the capsule's axis where the one nearest the worker's side is picked
@@ -89,26 +90,57 @@ def takes_way(row: CheckRow, layout, records, unsafe_row: int) -> bool:
     return row.way == "any"
 
 
-def aim_of(layout, point: RowPoint) -> Aim:
+def episode_times(sim, ts: np.ndarray, cycle: float) -> np.ndarray:
+    """Which of the episode times ``ts`` (from the cell's phase, modulo ``cycle``) some episode meets: those within
+    one episode's length after an arrival phase the search can choose (``sim.starts.arrival_phases``, every start
+    point's)."""
+    spec = sim.cell.spec
+    ep = spec.simulation
+    length = ep.dt * ep.steps_per_action * ep.actions_per_episode
+    phase0 = float(spec.robot.task.phase)
+    meets = np.zeros(len(ts), dtype=bool)
+    for start in spec.human.starts or (None,):
+        for phase in arrival_phases(sim, start):
+            meets |= np.mod(ts - (phase - phase0), cycle) <= length + 1e-9
+    return meets
+
+
+def aim_of(sim, point: RowPoint) -> Aim:
     """The robot point of a row's witness: on the axis of its capsule at its moment, the point nearest (across
-    the floor) to the worker's side, moved out to the capsule's surface towards it."""
+    the floor) to the worker's side, moved out to the capsule's surface towards it. A moment no episode meets (a
+    fixed arrival, and the row's closest approach later in the cycle than one episode reaches), or one at which
+    that capsule stands still, would aim at nothing the search can touch: then the nearest point over every
+    capsule of that robot at the moments an episode meets and it moves is taken instead (10 ms samples)."""
+    layout = sim.layout
     names = [p.name for p in layout.robots]
     robot = names.index(point.robot) if point.robot and point.robot in names else 0
     part = [c.name for c in layout.capsules].index(point.part)
     ts, caps, ra, rb = robot_poses(layout.params, SAMPLE_DT, robot=robot)[0]
+    cycle = float(layout.robots[robot].trajectory.cycle)
+    # (time, capsule) pairs an episode meets with the capsule moving faster than the criterion's standstill (a
+    # contact with a robot at rest is none): its ends' speed over the next 10 ms
+    speed = np.maximum(np.linalg.norm(np.roll(ra, -1, axis=0) - ra, axis=2),
+                       np.linalg.norm(np.roll(rb, -1, axis=0) - rb, axis=2)) / SAMPLE_DT
+    usable = episode_times(sim, ts, cycle)[:, None] & (speed > float(layout.params.scal[L.C_VTOL]))
     k = int(np.argmin(np.abs(ts - point.t)))
     j = int(np.flatnonzero(caps == part)[0])
-    s = np.linspace(0.0, 1.0, AXIS_SAMPLES)[:, None]
-    axis = ra[k, j] + s * (rb[k, j] - ra[k, j])
     (x0, y0), (x1, y1) = point.toward
-    d, qx, qy = point_segment(axis[:, 0], axis[:, 1], x0, y0, x1, y1)
-    i = int(np.argmin(d))
-    p = axis[i].copy()
-    step = np.array([qx[i] - p[0], qy[i] - p[1]])
+    s = np.linspace(0.0, 1.0, AXIS_SAMPLES)[None, None, :, None]
+    times, parts = np.array([k]), np.array([j])
+    if not usable[k, j] and usable.any():
+        times, parts = np.arange(len(ts)), np.arange(len(caps))
+    axis = ra[times][:, parts, None, :] + s * (rb[times][:, parts, None, :] - ra[times][:, parts, None, :])
+    d, qx, qy = point_segment(axis[..., 0], axis[..., 1], x0, y0, x1, y1)
+    radius = layout.params.cap_r[caps[parts]][None, :, None]
+    if len(times) > 1:
+        d = np.where(usable[:, :, None], d, np.inf)
+    ti, pj, si = np.unravel_index(int(np.argmin(d - radius)), d.shape)
+    p = axis[ti, pj, si].copy()
+    step = np.array([qx[ti, pj, si] - p[0], qy[ti, pj, si] - p[1]])
     gap = float(np.hypot(*step))
     if gap > 1e-9:
-        p[:2] += step / gap * min(float(layout.params.cap_r[part]), gap)
-    return Aim(robot, float(ts[k]), (float(p[0]), float(p[1]), float(p[2])))
+        p[:2] += step / gap * min(float(radius[0, pj, 0]), gap)
+    return Aim(robot, float(ts[times[ti]]), (float(p[0]), float(p[1]), float(p[2])))
 
 
 def aim_text(aim: Aim | None) -> str:
@@ -172,7 +204,7 @@ def witness_searches(sim, rows: tuple[CheckRow, ...], budget: int, seed: int, pr
             continue
         if progress is not None:
             progress(r.name)
-        aim = aim_of(sim.layout, r.point) if aimed and r.point is not None and math.isfinite(r.point.t) else None
+        aim = aim_of(sim, r.point) if aimed and r.point is not None and math.isfinite(r.point.t) else None
         text = aim_text(aim)
         res = run(text, "first")
         if res.hazard is None or takes(r, tuple(res.hazard.actions)):
