@@ -148,6 +148,8 @@ def test_check_witness_finds_each_rows_way_and_writes_replayable_results(capsys,
     head = next(i for i, ln in enumerate(lines) if ln.startswith("simulated witnesses (plan, 200 episodes"))
     rows = lines[head + 1: head + 3]
     assert rows[0].startswith("  front-scanner: FOUND at episode ") and "search-1" in rows[0]
+    # its search's first hazard was unseen (the undetected reach's way): the witness is further into the budget
+    assert ": among its hazards, episode " in rows[0]
     assert rows[1].startswith("  undetected-reach: FOUND at episode ") and "search-2" in rows[1]
     assert lines[-1].startswith("FAIL: the cell file is valid, the static check fails (")
     res = SearchResult.load(tmp_path / "w" / "search-1")

@@ -138,7 +138,10 @@ def _witness_lines(c, rows, budget: int, seed: int, out_dir) -> dict[str, str]:
                     folders[key] = str(w.result.write(out_dir / f"search-{len(folders) + 1}", inside=out_dir))
                 except OSError as exc:
                     raise fail(f"--out {out_dir}: cannot write result.json ({exc.strerror or exc})") from None
-            where = f" ({folders[key]})"
+            first = w.result.hazard
+            later = w.witness is not None and first is not None and w.witness.episode != first.episode
+            # (the file's ``hazard`` is its search's first; a witness further into the budget is one of its hazards)
+            where = f" ({folders[key]}" + (f": among its hazards, episode {w.witness.episode}" if later else "") + ")"
         said[w.row] = w.line() + where
         say(f"  {said[w.row]}")
     return said
