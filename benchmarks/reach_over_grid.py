@@ -2,6 +2,7 @@
 fails, or does the check name the limit of the simulated worker?
 
     python benchmarks/reach_over_grid.py [--tops 1.0 1.2 1.4 1.6] [--step 0.2] [--budget 200] [--seed 0]
+                                         [--witness]
 
 Each cell is ``reach-over`` with its front panel at another height b and moved so that the robot's hazard zone
 lies c behind it (the panel, the side walls' front ends and the worker's start, 0.75 m in front of the panel, move
@@ -11,7 +12,9 @@ min(c_iso, c_body): ISO 13857 Table 2 calls the panel open (c < c_iso) and the b
 (``human.reach_bound``: any model of a p95 man, trunk bent to 180 degrees, on tiptoe) says the body can get there.
 Per cell: the check's reach-over row and its ``limit`` (what the simulated worker cannot do), the other rows it
 fails, and `plan`'s first hazard within the budget (seed fixed). A cell agrees when plan finds the hazard or every
-row the check fails names a limit.
+row the check fails names a limit. ``--witness``: instead of one search, ``check --witness``'s searches
+(``analysis.witness``), and a cell agrees when every failing row has a witness that takes its own way in or names
+a limit; the plan column then counts the rows witnessed / named a limit / not reproduced.
 """
 
 from __future__ import annotations
@@ -28,9 +31,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 from cellstress.analysis.check_rows import check_rows  # noqa: E402
 from cellstress.analysis.iso13855 import check_cell  # noqa: E402
+from cellstress.analysis.witness import witness_searches  # noqa: E402
 from cellstress.api import search  # noqa: E402
 from cellstress.cell.load import builtin_text, parse_cell  # noqa: E402
 from cellstress.human.reach_bound import body_bound, c_bound  # noqa: E402
+from cellstress.sim.simulator import Simulator  # noqa: E402
 
 BASE = "reach-over"
 START_GAP = 0.75  # m: the worker's start in front of the panel, as in reach-over
@@ -64,6 +69,7 @@ def main() -> None:
     ap.add_argument("--step", type=float, default=0.2)
     ap.add_argument("--budget", type=int, default=200)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--witness", action="store_true", help="check --witness's searches, one per failing row")
     args = ap.parse_args()
     base = yaml.safe_load(builtin_text(BASE))
     y0 = base["fences"][0]["points"][0][1]
@@ -84,17 +90,26 @@ def main() -> None:
             cell = variant(base, top, round(zone_y + c, 3))
             reach_c, row, failing = panel_reach(cell)
             t0 = time.perf_counter()
-            res = search(cell, "plan", args.budget, args.seed)
+            if args.witness:
+                got = witness_searches(Simulator(cell), tuple(failing), args.budget, args.seed)
+                seen = sum(w.witness is not None for w in got)
+                named = sum(w.result is None and bool(w.limit) for w in got)
+                ok = seen + named == len(got)
+                found, episode = f"{seen} / {named} / {len(got) - seen - named}", \
+                    ", ".join(str(w.witness.episode) for w in got if w.witness is not None) or "-"
+            else:
+                res = search(cell, "plan", args.budget, args.seed)
+                ok = res.found or all(r.limit for r in failing)
+                found, episode = "FOUND" if res.found else "none", res.episodes if res.found else "-"
             secs = time.perf_counter() - t0
             limit = row.limit if row is not None else ""
-            ok = res.found or all(r.limit for r in failing)
             agree += ok
             total += 1
             verdict = "FAIL" if row is not None and not row.ok else "ok"
             print(f"| {top:.1f} | {reach_c.hazard_height:.2f} | {reach_c.behind:.3f} | {reach_c.required:.3f} | "
                   f"{c_body:.3f} | {verdict} | {limit or '-'} | "
-                  f"{', '.join(f'{r.name} ({bool(r.limit)})' for r in failing)} | {'FOUND' if res.found else 'none'} | "
-                  f"{res.episodes if res.found else '-'} | {secs:.0f} |", flush=True)
+                  f"{', '.join(f'{r.name} ({bool(r.limit)})' for r in failing)} | {found} | {episode} | {secs:.0f} |",
+                  flush=True)
             c += args.step
     print(f"\n{agree} of {total} cells agree (plan finds the hazard, or every row the check fails names the "
           "simulated worker's limit)")

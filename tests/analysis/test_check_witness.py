@@ -4,6 +4,8 @@ robot point, on the robot's surface at the row's moment."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import yaml
@@ -156,3 +158,19 @@ def test_a_row_about_one_robot_of_several_asks_for_a_contact_with_it() -> None:
     a_link = next(c.name for c in sim.layout.robots[0].capsules)
     records[at] = records[at].model_copy(update={"robot_link": a_link})
     assert not takes_way(row, sim.layout, records, at)
+
+
+def test_a_row_takes_a_witness_another_rows_search_found() -> None:
+    """s1-scanner-width's scanner row, and the same row without its point (searched unaimed), one episode each:
+    the unaimed search finds nothing in its one episode, the aimed one its witness; the blind row takes that
+    one (the same way in), from that search's result."""
+    sim = Simulator("s1-scanner-width")
+    rows = check_rows(check_cell(sim.cell, sim.layout), check_programs(sim.layout))
+    row = _row(rows, "front-scanner")
+    blind = replace(row, name="blind", point=None)
+    lone = witness_searches(sim, (blind,), 1, 0)[0]
+    assert lone.witness is None and "not reproduced in 1 episodes" in lone.line()
+    got = {w.row: w for w in witness_searches(sim, (blind, row), 1, 0)}
+    assert got["front-scanner"].witness is not None
+    assert got["blind"].witness == got["front-scanner"].witness
+    assert got["blind"].result is got["front-scanner"].result and got["blind"].aim is None

@@ -18,7 +18,8 @@ reach, a reach over a fence and a whole-body opening by a contact no stopping de
 stepping over, a low scanner plane and a short mat by a contact that device did not see; an automatic restart by
 a contact after the robot restarted by itself. The search runs to its first hazard; when that one takes another
 way in, it runs its whole budget and the first of its hazards that takes the row's way is the witness. Searches
-are shared between rows with the same aim.
+are shared between rows with the same aim, and a row its own search leaves without a witness takes one from
+another row's search where one takes its way (a hazard is a hazard, whoever found it).
 """
 
 from __future__ import annotations
@@ -178,7 +179,8 @@ def witness_searches(sim, rows: tuple[CheckRow, ...], budget: int, seed: int, pr
                      ) -> tuple[RowWitness, ...]:
     """Search a simulated witness for every failing row of ``rows`` (``check_rows``) on the cell simulator
     ``sim`` (module docstring): ``plan``, ``budget`` episodes from ``seed``; to the first hazard, and when that
-    one does not take the row's way in, the whole budget, whose hazards are then tried in order.
+    one does not take the row's way in, the whole budget, whose hazards are then tried in order; a row still
+    without a witness then takes the first hazard of the other rows' searches that takes its way.
     ``progress(row name)`` before each row's searches; ``aimed=False`` searches every row unaimed (to measure
     what the aim brings: benchmarks/check_witness.py)."""
     runs: dict[tuple[str, str], SearchResult] = {}
@@ -214,4 +216,15 @@ def witness_searches(sim, rows: tuple[CheckRow, ...], budget: int, seed: int, pr
         res = run(text, "budget")
         hit = next((h for h in res.hazards if takes(r, tuple(h.actions))), None)
         out.append(RowWitness(r.name, "", aim, res, hit, len(res.hazards)))
+    # a hazard is a hazard whichever row's search found it: a row its own search left without a witness takes the
+    # first one of the other searches (in the order they ran) that takes its way
+    failing = [r for r in rows if not r.ok]
+    for i, (r, w) in enumerate(zip(failing, out, strict=True)):
+        if w.result is None or w.witness is not None:
+            continue
+        for res in runs.values():
+            hit = next((h for h in res.hazards if takes(r, tuple(h.actions))), None)
+            if hit is not None:
+                out[i] = RowWitness(r.name, "", w.aim, res, hit, len(res.hazards))
+                break
     return tuple(out)
