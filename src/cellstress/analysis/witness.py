@@ -35,12 +35,12 @@ from cellstress.analysis.plane import point_segment
 from cellstress.searchers import search
 from cellstress.searchers.plan import Aim
 from cellstress.searchers.result import EpisodeRef, SearchResult
+from cellstress.searchers.why import STOPPING
 from cellstress.sim import layout as L
 from cellstress.sim.starts import arrival_phases
 
 SEARCHER = "plan"
 AXIS_SAMPLES = 41  # points along the capsule's axis where the one nearest the worker's side is picked
-STOPPING = ("stop-pending", "braking", "stopped")  # StepRecord.stop_phase while a stop holds the robot
 
 
 @dataclass(frozen=True)
@@ -65,14 +65,20 @@ class RowWitness:
         return f"{self.row}: FOUND at episode {w.episode} of {res.budget}: {', '.join(w.actions)}"
 
 
+def _robot_index(layout, name: str) -> int:
+    """The index of the robot ``name`` (a row's ``RowPoint.robot``) in ``layout.robots``; -1 for none ('' : a cell of
+    one robot)."""
+    names = [p.name for p in layout.robots]
+    return names.index(name) if name and name in names else -1
+
+
 def takes_way(row: CheckRow, layout, records, unsafe_row: int) -> bool:
     """Whether a hazardous episode (its step records, unsafe at ``unsafe_row``) takes ``row``'s way in
     (``CheckRow.way``); in a cell of several robots, a row about one of them asks for a contact with it."""
     before = records[: unsafe_row + 1]
     seen = {name for r in before for name in r.devices}
-    names = [p.name for p in layout.robots]
-    robot = names.index(row.point.robot) if row.point is not None and row.point.robot in names else -1
-    if robot >= 0 and len(names) > 1 and records[unsafe_row].robot_link not in \
+    robot = _robot_index(layout, row.point.robot) if row.point is not None else -1
+    if robot >= 0 and len(layout.robots) > 1 and records[unsafe_row].robot_link not in \
             {c.name for c in layout.robots[robot].capsules}:
         return False  # a row about one robot of several: the contact must be with that one
     if row.way == "late":
@@ -113,8 +119,7 @@ def aim_of(sim, point: RowPoint) -> Aim:
     that capsule stands still, would aim at nothing the search can touch: then the nearest point over every
     capsule of that robot at the moments an episode meets and it moves is taken instead (10 ms samples)."""
     layout = sim.layout
-    names = [p.name for p in layout.robots]
-    robot = names.index(point.robot) if point.robot and point.robot in names else 0
+    robot = max(_robot_index(layout, point.robot), 0)
     part = [c.name for c in layout.capsules].index(point.part)
     ts, caps, ra, rb = robot_poses(layout.params, SAMPLE_DT, robot=robot)[0]
     cycle = float(layout.robots[robot].trajectory.cycle)

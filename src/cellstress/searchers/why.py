@@ -17,7 +17,7 @@ def _r(t: float) -> float:
     return round(float(t), 9)  # k * dt carries float noise
 
 
-_STOPPING = ("stop-pending", "braking", "stopped")
+STOPPING = ("stop-pending", "braking", "stopped")  # StepRecord.stop_phase while a stop holds the robot
 
 
 def safeguard_words(layout, records, unsafe_row: int) -> str | None:
@@ -47,7 +47,7 @@ def safeguard_words(layout, records, unsafe_row: int) -> str | None:
                              f"from {_r(r.t + resp):.2f} s")
             if name in stop_names:
                 last_stop_seen = (name, r.t)
-        if prev is not None and prev.stop_phase in _STOPPING and r.stop_phase not in _STOPPING:
+        if prev is not None and prev.stop_phase in STOPPING and r.stop_phase not in STOPPING:
             who = "" if last_stop_seen is None else \
                 f"{last_stop_seen[0]} last saw the worker at {last_stop_seen[1]:.2f} s; "
             unseen = "while no device saw the worker" if not r.devices else f"while {', '.join(r.devices)} saw them"
