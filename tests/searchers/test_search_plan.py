@@ -4,6 +4,7 @@ is a pure function of its seed, refuses what it cannot search, and its model of 
 from __future__ import annotations
 
 import json
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 import pytest
@@ -13,7 +14,7 @@ from toywalk import ToyWalk
 from cellstress.cell.load import builtin_text, safe_load_yaml
 from cellstress.cli import main
 from cellstress.criteria.contact import ContactWhileMoving
-from cellstress.searchers import SearchError, run_search, searcher_class
+from cellstress.searchers import SearchError, plan, run_search, searcher_class
 from cellstress.searchers.plan import Plan, _Model
 from cellstress.searchers.result import SearchResult
 from cellstress.sim import layout as L
@@ -68,6 +69,23 @@ def test_same_seed_same_search(sims) -> None:
     a, b, c = (run_search(sim, reward, "plan", 30, s, until="budget") for s in (3, 3, 4))
     assert a == b and a.episodes == 30
     assert a.risks != c.risks
+
+
+@pytest.mark.parametrize("cell", ["door-unlocked", "palletizing", "reach-over"])
+def test_resuming_played_prefixes_changes_no_episode(cell, monkeypatch) -> None:
+    """``plan`` walks a candidate's played prefix once (``ResumableWorker``): the same episodes, risks and
+    hazards as walking every candidate from s0 (doors pushed, a searched arrival phase, the articulated worker)."""
+    sim = Simulator(cell)
+    reward = sim.criterion.reward(sim.actions_per_episode)
+    resumed = run_search(sim, reward, "plan", 25, 2, until="budget")
+
+    @runtime_checkable
+    class Nothing(Protocol):
+        def no_such_ability(self) -> None: ...
+
+    monkeypatch.setattr(plan, "ResumableWorker", Nothing)
+    walked = run_search(sim, reward, "plan", 25, 2, until="budget")
+    assert resumed == walked and resumed.episodes == 25
 
 
 def test_result_file_is_byte_identical(tmp_path, capsys) -> None:

@@ -61,3 +61,41 @@ def test_distance_to_the_robot_point_of_a_row_is_its_d_hr(cell) -> None:
     assert np.median(gap) < 0.01 and np.quantile(gap, 0.95) < 0.05, np.quantile(gap, [0.5, 0.95])
     far = sim.worker_distances(rows[:3, POSE], np.full((3, 2, 3), np.nan))
     assert np.all(far == np.inf)
+
+
+@pytest.mark.parametrize("cell", ["door-unlocked", "reach-over", "muting-long", "s3-fence-gap"])
+def test_a_path_resumed_from_its_states_is_the_same_path(cell) -> None:
+    """``worker_paths_from``: resumed at any action from the state an earlier call gave there, the poses and the
+    later states are bit for bit those of the whole path (doors pushed, the articulated worker's held arms,
+    walls), and the steps before are NaN."""
+    sim = Simulator(cell)
+    rng = np.random.default_rng(11)
+    h, spa = sim.actions_per_episode, sim.steps_per_action
+    acts = rng.integers(0, sim.n_actions, size=(40, h))
+    acts[:10] = rng.integers(0, 6, size=(10, h))  # straight walks: into walls and doors
+    whole = sim.worker_paths_from(acts)
+    assert np.array_equal(whole.poses, sim.worker_paths(acts))
+    assert whole.states.shape == (40, h + 1, L.NS) and np.array_equal(whole.states[:, 0], np.tile(sim.reset(), (40, 1)))
+    first = rng.integers(0, h + 1, size=40)
+    again = sim.worker_paths_from(acts, whole.states[np.arange(40), first], first)
+    for e in range(40):
+        k = first[e] * spa
+        assert np.isnan(again.poses[e, :k]).all() and np.isnan(again.states[e, : first[e]]).all()
+        assert np.array_equal(again.poses[e, k:], whole.poses[e, k:]), e
+        assert np.array_equal(again.states[e, first[e]:], whole.states[e, first[e]:]), e
+    # a different sequence after a shared prefix: resumed from the prefix's state, as if walked from s0
+    other = acts.copy()
+    other[:, h // 2:] = rng.integers(0, sim.n_actions, size=(40, h - h // 2))
+    mid = np.full(40, h // 2)
+    assert np.array_equal(sim.worker_paths_from(other, whole.states[:, h // 2], mid).poses[:, h // 2 * spa:],
+                          sim.worker_paths(other)[:, h // 2 * spa:])
+
+
+def test_bad_resume_is_refused() -> None:
+    sim = Simulator("baseline")
+    acts = np.zeros((2, sim.actions_per_episode), dtype=np.int64)
+    states = np.tile(sim.reset(), (2, 1))
+    for first, st in [(np.array([0, sim.actions_per_episode + 1]), states), (np.array([0, -1]), states),
+                      (np.array([0]), states), (np.array([0, 0]), states[:, :5])]:
+        with pytest.raises(ValueError):
+            sim.worker_paths_from(acts, st, first)

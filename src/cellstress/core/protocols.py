@@ -28,7 +28,16 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
-from cellstress.core.records import Channel, Contact, IsoDistance, KernelTest, Measures, Primitive, TimedPanel
+from cellstress.core.records import (
+    Channel,
+    Contact,
+    IsoDistance,
+    KernelTest,
+    Measures,
+    Primitive,
+    TimedPanel,
+    WorkerPaths,
+)
 
 
 # ---- rewards and recorders ----------------------------------------------------------------------------------
@@ -148,6 +157,16 @@ class WorkerModel(CellRows, Protocol):
     def worker_paths(self, actions: np.ndarray) -> np.ndarray: ...
 
     def worker_distances(self, poses: np.ndarray, points: np.ndarray) -> np.ndarray: ...
+
+
+@runtime_checkable
+class ResumableWorker(WorkerModel, Protocol):
+    """The worker's motion resumed part way: each sequence from the state an earlier call gave for the start of
+    one of its actions (``WorkerPaths.states``), so a sequence that shares its first actions with one already
+    computed does not walk them again (``Simulator.worker_paths_from``)."""
+
+    def worker_paths_from(self, actions: np.ndarray, states: np.ndarray | None = None,
+                          first: np.ndarray | None = None) -> WorkerPaths: ...
 
 
 @runtime_checkable

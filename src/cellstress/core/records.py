@@ -7,7 +7,7 @@ They hold numbers and names only (no arrays that change, no behaviour), so they 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 Point2 = tuple[float, float]
 Point3 = tuple[float, float, float]
@@ -23,6 +23,16 @@ class Measures(NamedTuple):
     severity: float | None = None
     # distinct mode: the unsafe state repeats a hazard class already found (a reward may pay it as a safe end)
     repeat: bool = False
+
+
+class WorkerPaths(NamedTuple):
+    """The worker's open-loop motion for many action sequences (``ResumableWorker.worker_paths_from``): pose
+    vectors at every time step, (episodes, steps, pose size), NaN before the step a sequence resumed at; and the
+    worker's state as each action begins and as the last ends, (episodes, actions + 1, state size), which a later
+    call resumes from."""
+
+    poses: Any
+    states: Any
 
 
 class KernelTest(NamedTuple):

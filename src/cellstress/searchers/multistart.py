@@ -117,6 +117,9 @@ class PhaseProblem(ArrivalProblem):
     def worker_paths(self, actions):
         return self.sim.worker_paths(actions)
 
+    def worker_paths_from(self, actions, states=None, first=None):
+        return self.sim.worker_paths_from(actions, states, first)
+
     def worker_distances(self, poses, points):
         return self.sim.worker_distances(poses, points)
 

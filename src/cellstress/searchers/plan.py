@@ -11,7 +11,8 @@ simulator as a black box; ``plan`` separates what the searcher controls from wha
   capsules and whose arms are posed by its actions, the distance is to those capsules at the pose
   (``Simulator.worker_capsules``), not to the reach volumes: the volumes are the same whatever the arms do, so
   with them every arm action of a candidate predicted alike and the search could not tell a reach over a panel
-  from hanging arms.
+  from hanging arms. A candidate that begins with a played prefix resumes the worker's path where that prefix
+  left it (``ResumableWorker``): its steps are neither walked nor looked up again.
 * **The robot system under test is learned** from the metric rows of the episodes played, and from nothing
   else:
 
@@ -72,7 +73,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from cellstress.core.protocols import StartChoices, WorkerModel
+from cellstress.core.protocols import ResumableWorker, StartChoices, WorkerModel
 from cellstress.searchers.common import Recorder, SearchError, number, whole
 from cellstress.searchers.evolve import REDRAWS
 from cellstress.sim import layout as L
@@ -258,6 +259,9 @@ class _Model:
         self.feats: list[np.ndarray] = []
         self.seen: list[np.ndarray] = []
         self._tree = self._by_step = None
+        # the worker's actions of a played prefix -> its state as the next action begins: a candidate that shares
+        # a played prefix resumes its path there (``ResumableWorker``; about a third of a candidate's steps)
+        self.walked: dict[tuple[int, ...], np.ndarray] | None = {} if isinstance(sim, ResumableWorker) else None
 
     def know(self, aim: Aim) -> None:
         """Take ``aim``'s point as on the moving robot at each path step of its moment (module docstring)."""
@@ -312,6 +316,8 @@ class _Model:
         return rows[:, L.M_PHASE] if r == 0 else rows[:, L.M_XPHASE + r - 1]
 
     def learn(self, actions: list[int], rows: np.ndarray) -> None:
+        if self.walked is not None:
+            self._walk(tuple(actions[self.lead:]))
         base = int(self.offsets[actions[0] % len(self.offsets)]) if self.lead else 0
         rows = rows[self.lead:]  # (a first decision's row is the initial state's)
         seen = rows[:, L.M_SEEN].astype(np.int64)
@@ -356,6 +362,35 @@ class _Model:
         self.seen.append(seen)
         self._tree = self._by_step = None
 
+    def _walk(self, worker: tuple[int, ...]) -> None:
+        """Keep the worker's state as each action of ``worker`` (actions played) begins, and as the last ends."""
+        q = len(worker)
+        while q >= 0 and worker[:q] not in self.walked:
+            q -= 1
+        if q == len(worker):
+            return
+        if q < 0:
+            paths, q = self.sim.worker_paths_from(np.array([worker], dtype=np.int64)), 0
+        else:
+            paths = self.sim.worker_paths_from(np.array([worker], dtype=np.int64), self.walked[worker[:q]][None, :],
+                                               np.array([q]))
+        for a in range(q, len(worker) + 1):
+            self.walked[worker[:a]] = paths.states[0, a]
+
+    def _paths(self, seqs: np.ndarray, walked: np.ndarray) -> np.ndarray:
+        """The worker's poses for the worker's actions ``seqs`` (n, actions), each resumed after its first
+        walked[i] actions where their state is known (the steps before are not needed: NaN)."""
+        if not self.walked:
+            return self.sim.worker_paths(seqs)
+        first = walked.copy()
+        states = np.empty((len(seqs), len(self.walked[()])))
+        for i, seq in enumerate(seqs.tolist()):
+            state = self.walked.get(tuple(seq[: first[i]]))
+            if state is None:
+                first[i], state = 0, self.walked[()]
+            states[i] = state
+        return self.sim.worker_paths_from(seqs, states, first).poses
+
     def _step_points(self, r: int) -> tuple[np.ndarray, np.ndarray]:
         """Robot r's points and offsets of every step, padded with NaN points: (steps + 1, m, 3), (steps + 1, m)."""
         if self._by_step is None:
@@ -376,14 +411,7 @@ class _Model:
         from scipy.spatial import cKDTree
 
         n, steps = len(seqs), self.n_steps
-        poses = self.sim.worker_paths(seqs[:, self.lead:]).reshape(-1, L.N_POSE)
-        if not self.feats:  # nothing played yet (an aimed start): no device is known to see anything
-            seen = np.zeros((n, steps), dtype=np.int64)
-        else:
-            if self._tree is None:
-                self._tree = (cKDTree(np.concatenate(self.feats)), np.concatenate(self.seen))
-            tree, seen_at = self._tree
-            seen = seen_at[tree.query(self._features(poses))[1]].reshape(n, steps)
+        seen = np.zeros((n, steps), dtype=np.int64)
         known = np.zeros(n, dtype=np.int64)
         played_brake = np.full((self.n_robots, n), -1)
         played_stop = np.full((self.n_robots, n), -1)
@@ -394,6 +422,16 @@ class _Model:
             if p:
                 known[i], seen_k, played_brake[:, i], played_stop[:, i] = self.prefixes[seq[:p]]
                 seen[i, : known[i]] = seen_k
+        poses = self._paths(seqs[:, self.lead:], known // self.spa).reshape(-1, L.N_POSE)
+        if self.feats:  # (nothing played yet, an aimed start: no device is known to see anything)
+            if self._tree is None:
+                self._tree = (cKDTree(np.concatenate(self.feats)), np.concatenate(self.seen))
+            tree, seen_at = self._tree
+            # a played prefix's detections are known: the tree is asked about the steps after it only
+            ask = np.flatnonzero((np.arange(steps)[None, :] >= known[:, None]).ravel())
+            # (a pose met again, standing at a wall or on a shared path, is asked once: a third of them)
+            feats, again = np.unique(self._features(poses[ask]), axis=0, return_inverse=True)
+            seen.ravel()[ask] = seen_at[tree.query(feats)[1]][again.ravel()]
         detected = seen.any(axis=1)
         first = (seen > 0).argmax(axis=1)
         mask = seen[np.arange(n), first]

@@ -226,7 +226,7 @@ def travel(layout: Layout, row: np.ndarray, joint: int, point, direction, v_push
     return best
 
 
-def robot_surface_points(layout: Layout, row: np.ndarray, work) -> tuple[np.ndarray, ...]:
+def robot_surface_points(layout: Layout, row: np.ndarray) -> tuple[np.ndarray, ...]:
     """Where a hand that may be anywhere in the worker's reach volumes can be pinned by the robot: points on robot
     0's capsules (``AXIS_SAMPLES`` along each axis, each moved out by the radius along its own direction of motion,
     the capsule's leading side) inside the worker's envelope at the row's pose (``kernels.worker_point_distances``:
@@ -259,7 +259,7 @@ def robot_surface_points(layout: Layout, row: np.ndarray, work) -> tuple[np.ndar
     if not len(lead):
         return lead, dirs, speed, np.zeros(0, dtype=np.int64)
     dist = np.empty((1, len(lead)))
-    K.worker_point_distances(P, work, np.ascontiguousarray(L.row_pose(row)[None, :]),
+    K.worker_point_distances(P, np.ascontiguousarray(L.row_pose(row)[None, :]),
                              np.ascontiguousarray(lead[None, :, :]), dist)
     inside = dist[0] <= 0.0
     return lead[inside], dirs[inside], speed[inside], P.cap_joint[caps[inside]].astype(np.int64)

@@ -22,7 +22,6 @@ from cellstress.human.regions import body_region
 from cellstress.robot.dynamics import point_dynamics, reflected_mass
 from cellstress.robot.model import load_pinocchio
 from cellstress.sim import clamping, scene
-from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
 from cellstress.sim.build import Layout
 from cellstress.sim.kernels.params import SWEEP_CERTIFIED, SWEEP_DEPTH
@@ -74,7 +73,6 @@ class ContactModel:
         jm = layout.joints
         self.reduce = None if len(jm.driven) == layout.robot.n_joints else jm.jacobian_map()
         self.surfaces = clamping.FixedSurfaces(layout)
-        self._work = K.make_work(P)  # the worker-only kernels' scratch (clamping.robot_surface_points)
 
     def contact(self, row: np.ndarray, before: np.ndarray | None = None) -> ContactInCell:
         """The closest points of a metric row, with the region, normal, v_rel and reflected mass there, and its
@@ -148,7 +146,7 @@ class ContactModel:
         """((surface, distance), point, direction, speed, joint) of the robot surface point inside the worker's
         envelope with the nearest fixed surface ahead of it (the least gap; the first such point on a tie), or
         None (``clamping.robot_surface_points``)."""
-        points, dirs, speeds, joints = clamping.robot_surface_points(self.layout, row, self._work)
+        points, dirs, speeds, joints = clamping.robot_surface_points(self.layout, row)
         if not len(points):
             return None
         which, dist = self.surfaces.nearest_many(points, dirs)

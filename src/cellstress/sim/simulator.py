@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from cellstress.cell.load import Cell, load_cell
-from cellstress.core.records import Measures
+from cellstress.core.records import Measures, WorkerPaths
 from cellstress.human.body import BODY_PARTS
 from cellstress.sim import kernels as K
 from cellstress.sim import layout as L
@@ -361,10 +361,26 @@ class Simulator:
         The worker's motion depends on the actions and the fixed layout (walls, table, floor) only, never on
         the robot or the devices, so this is exact and plays no episode: the rows of ``run`` hold the same poses
         up to the step where the episode ended."""
+        return self.worker_paths_from(actions).poses
+
+    def worker_paths_from(self, actions: np.ndarray, states: np.ndarray | None = None,
+                          first: np.ndarray | None = None) -> WorkerPaths:
+        """``worker_paths`` with the worker's state as each action begins and as the last ends. Given ``states``
+        and ``first``, episode e resumes at its action first[e] from states[e], the state as that action begins
+        (a ``WorkerPaths.states`` row of an earlier call): its steps before are NaN, the rest the same poses as
+        from s0."""
         acts = _action_array(actions, self.n_actions)
-        out = np.empty((acts.shape[0], acts.shape[1] * self.params.spa, L.N_POSE))
-        K.worker_paths(self.params, self._s0, acts, self._worker_work(), out)
-        return out
+        n, h = acts.shape
+        if states is None:
+            states, first = np.broadcast_to(self._s0, (n, L.NS)), np.zeros(n, np.int64)
+        first = np.ascontiguousarray(first, dtype=np.int64)
+        states = np.ascontiguousarray(states, dtype=np.float64)
+        if first.shape != (n,) or states.shape != (n, L.NS) or (n and (first.min() < 0 or first.max() > h)):
+            raise ValueError(f"first must be (n,) in 0..{h} and states (n, {L.NS}) for n = {n} episodes")
+        poses = np.full((n, h * self.params.spa, L.N_POSE), np.nan)
+        ends = np.full((n, h + 1, L.NS), np.nan)
+        K.worker_paths(self.params, states, first, acts, poses, ends)
+        return WorkerPaths(poses, ends)
 
     def worker_capsules(self, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The worker's body capsules at each of ``poses`` (n, N_POSE pose vectors): axis ends a, b (n, c, 3) and
@@ -390,7 +406,7 @@ class Simulator:
                 points.shape[::2] != (len(poses), 3):
             raise ValueError(f"poses must be (n, {L.N_POSE}) and points (n, m, 3)")
         out = np.empty(points.shape[:2])
-        K.worker_point_distances(self.params, self._worker_work(), poses, points, out)
+        K.worker_point_distances(self.params, poses, points, out)
         return out
 
     def _worker_work(self):

@@ -2,7 +2,7 @@
 
 Everything here is numba-compiled and works on ``SimParams`` (a named tuple of arrays built once per cell by
 ``sim.build``) and a state vector laid out as ``sim.layout`` describes. One module per concern, lowest first:
-params (the arrays), robot, body, fences, reach, sensing, separation, step, batch; a module imports only
+params (the arrays), robot, body, fences, reach, sensing, separation, step, batch, worker; a module imports only
 from those before it. numba inlines ``inline="always"`` functions across modules as within one, so the split
 costs nothing at run time.
 
@@ -38,9 +38,8 @@ from cellstress.sim.kernels.step import (
     reset_state,
     sense_and_measure,
     step_action,
-    worker_paths,
-    worker_point_distances,
 )
+from cellstress.sim.kernels.worker import worker_paths, worker_point_distances
 
 __all__ = [
     "SimParams", "Work", "make_work",

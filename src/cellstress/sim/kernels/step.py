@@ -1,5 +1,5 @@
-"""One time step: move the worker, sense (devices latch a stop), pose the robot, measure; and the worker's
-own motion and distances without the robot, for searchers that plan with it.
+"""One time step: move the worker, sense (devices latch a stop), pose the robot, measure (the worker's own
+motion and distances without the robot, for searchers that plan with it, are in ``kernels.worker``).
 
 The lifecycle follows dm_control's composer: move the worker -> sense -> move the robot -> measure. The step
 (step_action, sense_and_measure and the non-inlined helpers they call) allocates nothing and is compiled
@@ -12,11 +12,10 @@ import numpy as np
 
 from cellstress.core.jit import njit
 from cellstress.human.body import CRAWL_SPEED
-from cellstress.sim.geometry import NO_REFCOUNT, segment_segment_xyz
+from cellstress.sim.geometry import NO_REFCOUNT
 from cellstress.sim.kernels.body import pose_body
 from cellstress.sim.kernels.doors import door_signals, muted, note_push, place_doors, push_doors, unlock_doors
 from cellstress.sim.kernels.fences import collect_near_fences
-from cellstress.sim.kernels.reach import reach_value_at
 from cellstress.sim.kernels.robot import live_path_time, other_robots, robot_at
 from cellstress.sim.kernels.scaling import command, commands_due
 from cellstress.sim.kernels.sensing import body_blocked, device_sees, feet_ok, is_prone, path_blocked
@@ -74,7 +73,6 @@ from cellstress.sim.layout import (
     NO_WALK_BELOW,
     NS,
     PHASE_STOPPED,
-    POSE_EXT,
     S_A_SIG,
     S_A_T,
     S_A_TAU,
@@ -422,57 +420,3 @@ def blend_limbs(act, action, ext0, state, fwd, per_step, ext):
             rate = max(rate, abs(fwd - state[S_FWD]))  # keep up with the trunk it hangs from
         gap = to - cur
         ext[i] = to if abs(gap) <= rate * (1.0 + 1e-12) else cur + (rate if gap > 0.0 else -rate)
-
-
-@njit(cache=True, error_model="numpy")
-def worker_paths(P, s0, actions, W, out):
-    """The worker's poses (layout.POSE_STATE: x, y, heading, forward, lateral flexion, drop, arm joints) at every
-    time step of each episode of ``actions`` (n, n_actions) played from s0, as if no contact ended it: the
-    open-loop part of the simulation (``move_worker``), without robot, devices or measuring.
-    out: (n, n_actions * spa, N_POSE). A door without guard
-    locking opens here as played; one with guard locking stays locked (the robot's rest is not simulated)."""
-    state = np.empty(NS)
-    spa = P.spa
-    for e in range(actions.shape[0]):
-        state[:] = s0
-        k = 0
-        for a in range(actions.shape[1]):
-            h0, f0, l0 = state[S_HEADING], state[S_FWD], state[S_LAT]
-            begin_action(P, state, W)
-            for j in range(1, spa + 1):
-                move_worker(P, state, actions[e, a], h0, f0, l0, j / spa, W)
-                state[S_K] += 1.0  # (a door pushed opens on the clock)
-                out[e, k, 0], out[e, k, 1], out[e, k, 2] = state[S_X], state[S_Y], state[S_HEADING]
-                out[e, k, 3], out[e, k, 4] = state[S_FWD], state[S_LAT]
-                for i in range(11):
-                    out[e, k, POSE_EXT + i] = state[S_DROP + i]
-                k += 1
-
-
-@njit(cache=True, error_model="numpy")
-def worker_point_distances(P, W, poses, points, out):
-    """out[i, j]: distance from the worker at poses[i] (layout.POSE_STATE's order) to the point points[i, j], as
-    ``separation`` measures the paper worker's side of d_HR: the nearer of the two reach volumes (fences
-    respected) and the body capsules; inf for a NaN point. The robot plays no part. For the articulated worker
-    the reach volumes are its conservative envelope: where its arms could be within the action that follows."""
-    arm, origin, grid_h = P.body[B_ARM_LEN], P.scal[C_REACH_ORIGIN], P.scal[C_REACH_H]
-    ha, hb, hr, sh, tr = W.ha, W.hb, W.hr, W.sh, W.tr
-    n_caps = int(P.body[B_N_CAPS])
-    for i in range(poses.shape[0]):
-        pose_body(P.body, poses[i, 0], poses[i, 1], poses[i, 2], poses[i, 3], poses[i, 4], poses[i], POSE_EXT,
-                  ha, hb, hr, sh, tr)
-        n_near = collect_near_fences(P.fences, sh, W.near, arm + 0.05)
-        for j in range(points.shape[1]):
-            px, py, pz = points[i, j, 0], points[i, j, 1], points[i, j, 2]
-            if np.isnan(px):
-                out[i, j] = np.inf
-                continue
-            best = np.inf
-            for side in range(2):
-                best = min(best, reach_value_at(P.reach, origin, grid_h, arm, P.fences, W.near, sh, tr, side, n_near,
-                                              px, py, pz))
-            for c in range(n_caps):
-                d2 = segment_segment_xyz(ha[c, 0], ha[c, 1], ha[c, 2], hb[c, 0], hb[c, 1], hb[c, 2],
-                                         px, py, pz, px, py, pz)[0]
-                best = min(best, np.sqrt(d2) - hr[c])
-            out[i, j] = best
