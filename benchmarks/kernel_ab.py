@@ -108,9 +108,10 @@ def main(argv=None) -> None:
         what = f"plan, {args.plan} episodes" if args.plan else "worker kernels" if args.worker else "step" \
             if args.step else "run_batch"
         what += f", {args.threads} thread{'s' if args.threads > 1 else ''}"
-        print(f"{cell:20s} old {a:9,.0f}  new {b:9,.0f} episodes/s ({what})  new/old {b / a:.2f}"
-              f"   (rounds: old {' '.join(f'{r:,.0f}' for r in rates[args.old])};"
-              f" new {' '.join(f'{r:,.0f}' for r in rates[args.new])})", flush=True)
+        f = ",.2f" if args.plan else ",.0f"  # (a plan search plays a few episodes a second)
+        print(f"{cell:20s} old {a:9{f}}  new {b:9{f}} episodes/s ({what})  new/old {b / a:.2f}"
+              f"   (rounds: old {' '.join(f'{r:{f}}' for r in rates[args.old])};"
+              f" new {' '.join(f'{r:{f}}' for r in rates[args.new])})", flush=True)
 
 
 if __name__ == "__main__":

@@ -5,7 +5,7 @@
 Runs ``cellstress.search(CELL, searcher="plan", budget=..., until="budget")`` once in this process (run any
 command once first so that the kernels are compiled) and prints the wall time of the whole search and the
 seconds spent in ``_Model.predict`` (scoring the candidate sequences before each episode), within it building
-and querying the k-d tree of learned worker poses (which devices see a pose), ``Simulator.worker_paths`` and
+and querying the k-d tree of learned worker poses (which devices see a pose), ``Simulator.worker_paths_from`` and
 ``Simulator.worker_distances``, and in ``_Model.learn``. The timers wrap the calls; the search itself is the
 same (same episodes, same result).
 """
@@ -67,7 +67,7 @@ def main() -> None:
     scipy.spatial.cKDTree = TimedTree
     timed(plan._Model, "predict", "predict (all)")
     timed(plan._Model, "learn", "learn")
-    timed(Simulator, "worker_paths", "worker_paths")
+    timed(Simulator, "worker_paths_from", "worker_paths")  # (worker_paths calls it)
     timed(Simulator, "worker_distances", "worker_distances")
     t0 = time.perf_counter()
     res = cellstress.search(args.cell, searcher="plan", budget=args.budget, seed=args.seed, until="budget")
