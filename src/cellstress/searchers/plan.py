@@ -365,6 +365,8 @@ class _Model:
     def _walk(self, worker: tuple[int, ...]) -> None:
         """Keep the worker's state as each action of ``worker`` (actions played) begins, and as the last ends."""
         q = len(worker)
+        if not q:
+            return  # (an episode that ended at its first decision: the worker has not moved)
         while q >= 0 and worker[:q] not in self.walked:
             q -= 1
         if q == len(worker):
