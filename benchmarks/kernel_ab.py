@@ -55,12 +55,13 @@ print(n / best)
 
 CHILD_WORKER = r"""
 import sys, time, numpy as np
+from cellstress.sim import layout as L
 from cellstress.sim.simulator import Simulator
 sim = Simulator(sys.argv[1]); n = int(sys.argv[2]) // 20
 rng = np.random.default_rng(0)
 acts = rng.integers(0, 30, size=(n, sim.actions_per_episode))
 def play(a):
-    poses = sim.worker_paths(a).reshape(-1, sim.worker_paths(a[:1]).shape[-1])
+    poses = sim.worker_paths(a).reshape(-1, L.N_POSE)
     pts = poses[:, None, :3] + rng.normal(0.0, 0.6, size=(len(poses), 4, 3)) + np.array([0.0, 0.0, 1.0])
     sim.worker_distances(poses, pts)
 play(acts[:50])
